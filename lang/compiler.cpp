@@ -88,6 +88,11 @@ private:
     Value component(const Value& v, int k, Span span);
     Value splat(const Value& v, int width, Span span);
     Value hostInput(const HostVariable& hv);
+    const HostVariable* findHost(const std::string& name) const {
+        for (const HostVariable& hv : mOpt.variables)
+            if (hv.name == name) return &hv;
+        return nullptr;
+    }
     bool allConstant(const Instr& in) const;
 
     // ---- expressions ----
@@ -208,6 +213,7 @@ Value Compiler::emit(Instr in, Type result, bool pure) {
         }
         return {};
     }
+    in.width = result.width;
     if (pure && mOpt.folder && allConstant(in)) {
         std::vector<double> values;
         std::string text;
@@ -227,7 +233,7 @@ Value Compiler::emit(Instr in, Type result, bool pure) {
 // Component k of a numeric value as a width-1 value (no code: an alias or a constant).
 Value Compiler::component(const Value& v, int k, Span) {
     if (!v.ok()) return v;
-    const RegInfo& info = mBc.reg(v.reg);
+    const RegInfo info = mBc.reg(v.reg); // a copy: addReg below may reallocate
     if (k < 0 || k >= info.width) return constant(0.0);
     if (info.width == 1) return v;
     if (info.lifetime == Lifetime::Constant) return constant(mBc.constant(v.reg, k));
@@ -236,7 +242,8 @@ Value Compiler::component(const Value& v, int k, Span) {
     alias.lifetime = info.lifetime;
     alias.aliasOf = v.reg;
     alias.component = static_cast<uint8_t>(k);
-    return {mBc.addReg(alias), Type::fp(1, info.lifetime)};
+    const Reg r = mBc.addReg(alias);
+    return {r, Type::fp(1, info.lifetime)};
 }
 
 Value Compiler::splat(const Value& v, int width, Span span) {
@@ -292,8 +299,7 @@ Value Compiler::variable(const Expr* e) {
         return b.value;
     }
     if (const BuiltinConstant* c = findConstant(e->text)) return constant(c->value);
-    for (const HostVariable& hv : mOpt.variables)
-        if (hv.name == e->text) return hostInput(hv);
+    if (const HostVariable* hv = findHost(e->text)) return hostInput(*hv);
     Diagnostic* d = error(e->span, "unknown variable '" + std::string(e->dollar ? "$" : "") + e->text + "'");
     if (d) {
         std::vector<std::string_view> names;
@@ -415,6 +421,12 @@ Value Compiler::binaryValues(BinaryOp op, const Value& a, const Value& b, Span s
         return {};
     }
     if (op == BinaryOp::Eq || op == BinaryOp::Ne) return emit(in, Type::fp(1, l));
+    // x^2 is x*x: both are the correctly rounded square, and a multiply is far cheaper.
+    if (op == BinaryOp::Pow && b.type.lifetime == Lifetime::Constant && b.type.width == 1 &&
+        a.type.lifetime != Lifetime::Constant && mBc.constant(b.reg) == 2.0) {
+        in.op = Op::Mul;
+        in.b = a.reg;
+    }
     return emit(in, Type::fp(w, l));
 }
 
@@ -785,6 +797,19 @@ void Compiler::ifStatement(const Stmt* s) {
         auto f = elseEnv.find(name);
         auto b = before.find(name);
         if (t == thenEnv.end() || f == elseEnv.end()) {
+            // Assigned in one branch only, and not before as a local. A host variable or a
+            // built-in constant of that name is the value before: merge with it.
+            Value outer;
+            if (const HostVariable* hv = findHost(name)) outer = hostInput(*hv);
+            if (outer.ok()) {
+                Binding ob{outer, {}, {}, {}};
+                (t == thenEnv.end() ? thenEnv : elseEnv)[name] = ob;
+                t = thenEnv.find(name);
+                f = elseEnv.find(name);
+                b = before.end();
+            }
+        }
+        if (t == thenEnv.end() || f == elseEnv.end()) {
             // Assigned in one branch only, and not before (else both maps would have it).
             const Binding& only = t != thenEnv.end() ? t->second : f->second;
             Binding u;
@@ -867,42 +892,39 @@ void Compiler::checkRecursion() {
             for (const Expr* a : e->args) stack.push_back(a);
         }
     }
-    // A def is recursive when it can reach itself.
-    for (const auto& kv : mDefs) {
-        const FunctionDef* start = kv.second;
+    // Reachability in the call graph.
+    auto reaches = [&](const FunctionDef* from, const FunctionDef* to) {
         std::set<const FunctionDef*> seen;
-        std::vector<std::pair<const FunctionDef*, Span>> work = calls[start];
-        std::map<const FunctionDef*, Span> firstCall;
-        for (const auto& c : work) firstCall.insert({c.first, c.second});
-        bool recursive = false;
-        while (!work.empty() && !recursive) {
-            auto [f, span] = work.back();
+        std::vector<const FunctionDef*> work{from};
+        while (!work.empty()) {
+            const FunctionDef* f = work.back();
             work.pop_back();
-            if (f == start) recursive = true;
             if (!seen.insert(f).second) continue;
-            for (const auto& c : calls[f]) work.push_back(c);
-        }
-        if (!recursive) continue;
-        mRecursive.insert(start);
-        // Point at the def's own call that starts the cycle.
-        Span at = start->nameSpan;
-        for (const auto& c : calls[start]) {
-            std::set<const FunctionDef*> s2;
-            std::vector<const FunctionDef*> w2{c.first};
-            bool back = false;
-            while (!w2.empty()) {
-                const FunctionDef* f = w2.back();
-                w2.pop_back();
-                if (f == start) { back = true; break; }
-                if (!s2.insert(f).second) continue;
-                for (const auto& cc : calls[f]) w2.push_back(cc.first);
+            for (const auto& c : calls[f]) {
+                if (c.first == to) return true;
+                work.push_back(c.first);
             }
-            if (back) { at = c.second; break; }
         }
-        Diagnostic* d = error(at, "function '" + start->name +
-                                      "' recurses (calls itself, directly or through other functions); "
-                                      "recursion is not allowed");
-        note(d, start->nameSpan, "'" + start->name + "' is defined here");
+        return false;
+    };
+    // In source order, a call from D back to a def E at or before D that reaches D closes a
+    // cycle: report it there, once per cycle (every def on it is then known recursive).
+    std::map<const FunctionDef*, size_t> order;
+    for (size_t i = 0; i < mAst.defs.size(); ++i)
+        if (mAst.defs[i] && !order.count(mAst.defs[i])) order[mAst.defs[i]] = i;
+    for (const FunctionDef* d : mAst.defs) {
+        if (!d || mDefs.count(d->name) == 0 || mDefs[d->name] != d) continue;
+        for (const auto& [callee, span] : calls[d]) {
+            if (order[callee] > order[d] || (callee != d && !reaches(callee, d))) continue;
+            if (mRecursive.count(d) && mRecursive.count(callee)) continue; // cycle already reported
+            for (const auto& kv : mDefs)
+                if (kv.second == d || kv.second == callee || (reaches(kv.second, d) && reaches(d, kv.second)))
+                    mRecursive.insert(kv.second);
+            Diagnostic* diag = error(span, "function '" + d->name + "' recurses (" +
+                                               (callee == d ? "calls itself" : "through '" + callee->name + "'") +
+                                               "); recursion is not allowed");
+            note(diag, callee->nameSpan, "'" + callee->name + "' is defined here");
+        }
     }
 }
 

@@ -84,6 +84,8 @@ bool parseSignature(std::string_view text, ParsedSignature& out, std::string* er
             ParamSpec p;
             if (!r.type(p)) return fail("expected a parameter type");
             p.name = r.name();
+            bool dotsInName = p.name.size() > 3 && p.name.compare(p.name.size() - 3, 3, "...") == 0;
+            if (dotsInName) p.name.resize(p.name.size() - 3);
             if (p.name.empty()) return fail("expected a parameter name");
             if (r.eat('=')) {
                 if (p.kind != ParamSpec::Float || !r.number(p.defaultValue)) return fail("bad default value");
@@ -92,7 +94,7 @@ bool parseSignature(std::string_view text, ParsedSignature& out, std::string* er
             } else if (seenDefault) {
                 return fail("a parameter without default follows one with a default");
             }
-            bool variadic = r.eatWord("...");
+            bool variadic = dotsInName || r.eatWord("...");
             out.params.push_back(p);
             if (variadic) {
                 out.variadic = true;

@@ -249,6 +249,8 @@ EvalResult evaluate(const Program& program, const EvalRequest& request, const Ev
     // Fill a block's varying inputs and run its varying code.
     auto runLanes = [&](ThreadState<T>& st, size_t first, int n, std::string* messages) {
         ExecContext<T>& ctx = st.ctx;
+        ctx.varying = st.varying.data(); // (the state may have been copied since it was made)
+        ctx.varyingStrings = st.varyingStrings.data();
         ctx.n = n;
         ctx.messages = messages;
         for (const VaryingBind& vb : varyingBinds) {
@@ -318,7 +320,9 @@ EvalResult evaluate(const Program& program, const EvalRequest& request, const Ev
     };
 
     int threads = request.threads;
-    if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    // More threads than cores cannot help (and TBB warns about it): clamp.
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    if (threads <= 0 || threads > cores) threads = cores;
     if (threads == 1 || blocks <= 1) {
         for (size_t b = 0; b < blocks; ++b) runBlock(b);
     } else {
