@@ -83,5 +83,6 @@ void addMathBuiltins(FunctionTable& t);   // builtins_math.cpp: math, remap, vec
 void addCurveBuiltins(FunctionTable& t);  // builtins_curve.cpp: spline, curve, ccurve
 void addStringBuiltins(FunctionTable& t); // builtins_string.cpp: sprintf, printf (getVar is
                                           // compiled by the compiler itself)
+void addNoiseBuiltins(FunctionTable& t);  // noise*.cpp: the SeExpr2 noise family, curl noise
 
 } // namespace gale::runtime

@@ -1,0 +1,87 @@
+// The `gale` subcommands: exit codes, each command's options and entry point, and the hook
+// that adds it to the CLI11 parser. A new subcommand is one new cli/*_command.cpp defining
+// its add*Command (declared here) plus one line in main.cpp's command list.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace gale::cli {
+
+// Exit codes (the contract in spec/cli.md).
+enum ExitCode : int {
+    kExitOk = 0,
+    kExitInput = 1,   // the input was read but is wrong (diagnostics printed)
+    kExitUsage = 2,   // bad flags
+    kExitIo = 3,      // missing file, unwritable output
+    kExitNumeric = 4, // non-finite results (eval --checked)
+};
+
+// A subcommand registered with the parser, and what to run when it was chosen.
+struct Command {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+// Options shared by the commands that compile an expression.
+struct SourceOptions {
+    std::string file; // FILE.se, or "-" for stdin
+    std::string expr; // -e EXPR
+    std::vector<std::string> sets; // --set NAME=VALUE
+    std::string type = "auto";     // auto | float | vector
+};
+
+struct CheckOptions {
+    std::vector<std::string> files;
+    std::string expr;
+    std::vector<std::string> sets;
+    std::string type = "auto";
+    std::string points; // declare this point file's columns as variables
+};
+
+struct EvalOptions {
+    SourceOptions source;
+    std::string points;   // --points IN ("-": CSV on stdin)
+    double time = 0.0;
+    bool hasTime = false;
+    double frame = 0.0;
+    bool hasFrame = false;
+    double fps = 24.0;
+    std::string precision = "float";
+    int threads = -1;     // -1: all hardware threads with --points, 1 without
+    std::string output;   // -o OUT ("-" or empty: stdout)
+    std::string format;   // csv | ply | ply-ascii | json | npy | obj (empty: from -o, else csv)
+    bool disasm = false;
+    bool checked = false;
+};
+
+struct BenchOptions {
+    SourceOptions source;
+    long long points = 1'000'000;
+    int threads = 1; // 0: all hardware threads
+    std::string precision = "float";
+    bool json = false;
+    int repeat = 0;  // 0: until >= 0.5 s and at least 3 runs
+    double time = 0.0;
+};
+
+struct BuiltinsOptions {
+    bool json = false;
+};
+
+int runCheck(const CheckOptions& options);
+int runEval(const EvalOptions& options);
+int runBench(const BenchOptions& options);
+int runBuiltins(const BuiltinsOptions& options);
+
+Command addCheckCommand(CLI::App& app);
+Command addEvalCommand(CLI::App& app);
+Command addBenchCommand(CLI::App& app);
+Command addBuiltinsCommand(CLI::App& app);
+
+} // namespace gale::cli

@@ -1,0 +1,103 @@
+// Helpers shared by the subcommands: reading sources, --set values, host bindings (standard
+// variables, point columns, --set uniforms), compiling with diagnostics printed, number
+// output and atomic text files.
+#pragma once
+
+#include "cli/commands.h"
+#include "fields/pointset.h"
+#include "lang/source.h"
+#include "runtime/program.h"
+
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+class Option;
+} // namespace CLI
+
+namespace gale::cli {
+
+// "gale: <message>" on stderr.
+void printError(const std::string& message);
+// Colour diagnostics when stderr is a terminal and NO_COLOR is unset or empty.
+bool useColor();
+
+// Reads a whole file ("-": stdin). On failure `error` is the strerror text.
+bool readTextFile(const std::string& path, std::string& text, std::string& error);
+// The expression of FILE | -e EXPR as a SourceFile named by the path ("<stdin>" for "-")
+// or "<expr>". Returns an exit code (0 on success) after printing any problem.
+int loadSource(const std::string& file, const std::string& expr, lang::SourceFile& out);
+
+// --set NAME=VALUE: a number, a comma-separated vector, or a quoted string ("text").
+struct SetValue {
+    std::string name;
+    std::vector<double> value;
+    bool isString = false;
+    std::string text;
+};
+// Parses every --set; prints the problem and returns false on a malformed one.
+bool parseSets(const std::vector<std::string>& sets, std::vector<SetValue>& out);
+
+// --type auto|float|vector -> CompileSettings::wantWidth.
+int wantWidthFor(const std::string& type);
+
+// Host variables and their values for one evaluation: the standard ones, a point set's
+// columns (varying), --set values (uniform). A later binding of a name replaces an earlier.
+class Bindings {
+public:
+    // $P = (0,0,0) for one point, $t, $frame, $fps uniforms, $id filled by the VM.
+    Bindings(double t, double frame, double fps);
+
+    void setUniform(const std::string& name, std::vector<double> value);
+    void setUniformString(const std::string& name, std::string text);
+    // Component k of point i at data[i * pointStride + k * compStride]; `data` must outlive
+    // the evaluation.
+    void setVarying(const std::string& name, int width, const double* data, std::ptrdiff_t pointStride,
+                    std::ptrdiff_t compStride);
+    // Every column of `points` as a varying variable (P from x,y,z, ...); multi-component
+    // variables are interleaved into storage owned here. `points` must outlive evaluation.
+    void addPoints(const fields::PointSet& points);
+    void addSets(const std::vector<SetValue>& sets);
+
+    const std::vector<lang::HostVariable>& variables() const { return mVariables; }
+    void fillRequest(runtime::EvalRequest& request) const;
+
+private:
+    void declare(const std::string& name, lang::Type type);
+    void forget(const std::string& name);
+
+    std::vector<lang::HostVariable> mVariables;
+    std::vector<runtime::UniformValue> mUniforms;
+    std::vector<runtime::VaryingInput> mVaryings;
+    std::deque<std::vector<double>> mStorage;
+};
+
+// Compiles `source`, printing every diagnostic (errors and warnings) to stderr. Null on
+// errors.
+std::shared_ptr<const runtime::Program> compileAndReport(const lang::SourceFile& source,
+                                                         const std::vector<lang::HostVariable>& variables,
+                                                         int wantWidth);
+
+// Reads a point file, printing IoError::render() on failure; returns an exit code.
+int loadPoints(const std::string& path, fields::PointSet& points);
+
+// Shortest round-trip text of a value computed in float (`asFloat`) or double.
+std::string formatValue(double v, bool asFloat);
+
+// Writes `text` to `path` through a temporary file and a rename; prints the problem and
+// returns kExitIo on failure.
+int writeTextFileAtomic(const std::string& path, const std::string& text);
+
+// A JSON string literal.
+std::string jsonString(const std::string& s);
+
+// Word-wraps help text to `width` columns (CLI11 indents the continuation lines).
+std::string wrapHelp(const std::string& text, size_t width = 62);
+
+// Adds `FILE` / `-e,--expr` / `--set` / `--type` to a subcommand.
+void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType = true);
+
+} // namespace gale::cli
