@@ -103,13 +103,14 @@ int runBench(const BenchOptions& o) {
     char ns[64];
     if (o.json) {
         std::snprintf(ns, sizeof ns, "%.4g", nsPerPoint);
-        std::cout << "{\"ns_per_point\": " << ns << ", \"points\": " << n << ", \"threads\": " << threads
-                  << ", \"precision\": \"" << (asFloat ? "float" : "double") << "\", \"runs\": " << runs
-                  << "}\n";
+        std::cout << "{\"ns_per_point\": " << ns << ", \"points\": " << n
+                  << ", \"threads\": " << threads << ", \"precision\": \""
+                  << (asFloat ? "float" : "double") << "\", \"runs\": " << runs << "}\n";
     } else {
         std::snprintf(ns, sizeof ns, "%.3g", nsPerPoint);
-        std::cout << "ns/point: " << ns << "  (points " << n << ", threads " << threads << ", precision "
-                  << (asFloat ? "float" : "double") << ", best of " << runs << ")\n";
+        std::cout << "ns/point: " << ns << "  (points " << n << ", threads " << threads
+                  << ", precision " << (asFloat ? "float" : "double") << ", best of " << runs
+                  << ")\n";
     }
     std::cout.flush();
     return std::cout ? kExitOk : kExitIo;
@@ -131,7 +132,8 @@ Command addBenchCommand(CLI::App& app) {
     sub->add_option("--repeat", o->repeat,
                     "Timed runs (default: repeat until 0.5 s in total and at least 3 runs)")
         ->type_name("R");
-    sub->add_option("--time", o->time, "$t in seconds ($frame = t*24, $fps = 24)")->capture_default_str();
+    sub->add_option("--time", o->time, "$t in seconds ($frame = t*24, $fps = 24)")
+        ->capture_default_str();
     sub->add_flag("--json", o->json,
                   "Print {\"ns_per_point\": ..., \"points\": ..., \"threads\": ..., \"precision\": "
                   "..., \"runs\": ...}");

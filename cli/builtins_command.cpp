@@ -37,8 +37,10 @@ int runBuiltins(const BuiltinsOptions& o) {
             std::string sig(b.info.signature);
             out += sig;
             if (!b.info.doc.empty()) {
-                if (sig.size() >= column) out += "\n" + std::string(column, ' ');
-                else out += std::string(column - sig.size(), ' ');
+                if (sig.size() >= column)
+                    out += "\n" + std::string(column, ' ');
+                else
+                    out += std::string(column - sig.size(), ' ');
                 out += "  ";
                 out += b.info.doc;
             }
@@ -54,8 +56,7 @@ Command addBuiltinsCommand(CLI::App& app) {
     CLI::App* sub = app.add_subcommand(
         "builtins", "List every built-in function with its signature and one-line doc (the "
                     "table the compiler uses).");
-    sub->add_flag("--json", o->json,
-                  "Print a JSON array of {name, signature, doc, foldable}");
+    sub->add_flag("--json", o->json, "Print a JSON array of {name, signature, doc, foldable}");
     return {sub, [o] { return runBuiltins(*o); }};
 }
 

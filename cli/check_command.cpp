@@ -30,7 +30,8 @@ int runCheck(const CheckOptions& options) {
         int rc = loadSource(file, expr, source);
         if (rc == kExitIo) sawIoError = true;
         if (rc != kExitOk) return;
-        if (!compileAndReport(source, bindings.variables(), wantWidthFor(options.type))) sawError = true;
+        if (!compileAndReport(source, bindings.variables(), wantWidthFor(options.type)))
+            sawError = true;
     };
     for (const std::string& file : options.files) checkOne(file, "");
     if (!options.expr.empty()) checkOne("", options.expr);

@@ -30,8 +30,8 @@ struct Command {
 
 // Options shared by the commands that compile an expression.
 struct SourceOptions {
-    std::string file; // FILE.se, or "-" for stdin
-    std::string expr; // -e EXPR
+    std::string file;              // FILE.se, or "-" for stdin
+    std::string expr;              // -e EXPR
     std::vector<std::string> sets; // --set NAME=VALUE
     std::string type = "auto";     // auto | float | vector
 };
@@ -46,16 +46,16 @@ struct CheckOptions {
 
 struct EvalOptions {
     SourceOptions source;
-    std::string points;   // --points IN ("-": CSV on stdin)
+    std::string points; // --points IN ("-": CSV on stdin)
     double time = 0.0;
     bool hasTime = false;
     double frame = 0.0;
     bool hasFrame = false;
     double fps = 24.0;
     std::string precision = "float";
-    int threads = -1;     // -1: all hardware threads with --points, 1 without
-    std::string output;   // -o OUT ("-" or empty: stdout)
-    std::string format;   // csv | ply | ply-ascii | json | npy | obj (empty: from -o, else csv)
+    int threads = -1;   // -1: all hardware threads with --points, 1 without
+    std::string output; // -o OUT ("-" or empty: stdout)
+    std::string format; // csv | ply | ply-ascii | json | npy | obj (empty: from -o, else csv)
     bool disasm = false;
     bool checked = false;
 };
@@ -66,7 +66,7 @@ struct BenchOptions {
     int threads = 1; // 0: all hardware threads
     std::string precision = "float";
     bool json = false;
-    int repeat = 0;  // 0: until >= 0.5 s and at least 3 runs
+    int repeat = 0; // 0: until >= 0.5 s and at least 3 runs
     double time = 0.0;
 };
 

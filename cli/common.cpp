@@ -20,7 +20,9 @@
 
 namespace gale::cli {
 
-void printError(const std::string& message) { std::cerr << "gale: " << message << '\n'; }
+void printError(const std::string& message) {
+    std::cerr << "gale: " << message << '\n';
+}
 
 bool useColor() {
     const char* noColor = std::getenv("NO_COLOR");
@@ -100,7 +102,8 @@ bool parseSets(const std::vector<std::string>& sets, std::vector<SetValue>& out)
         v.name = trim(eq == std::string::npos ? s : s.substr(0, eq));
         if (!v.name.empty() && v.name[0] == '$') v.name.erase(0, 1);
         if (eq == std::string::npos || !validName(v.name)) {
-            printError("--set '" + s + "': expected NAME=VALUE with a variable name such as "
+            printError("--set '" + s +
+                       "': expected NAME=VALUE with a variable name such as "
                        "speed or wind.gain");
             return false;
         }
@@ -128,7 +131,8 @@ bool parseSets(const std::vector<std::string>& sets, std::vector<SetValue>& out)
         if (ok && !value.empty() && value.back() == ',') ok = false;
         if (!ok || v.value.empty() || v.value.size() > static_cast<size_t>(lang::kMaxWidth)) {
             printError("--set '" + s + "': the value must be a number, up to " +
-                       std::to_string(lang::kMaxWidth) + " comma-separated numbers (1,2,3), or a "
+                       std::to_string(lang::kMaxWidth) +
+                       " comma-separated numbers (1,2,3), or a "
                        "quoted string");
             return false;
         }
@@ -166,9 +170,11 @@ void Bindings::declare(const std::string& name, lang::Type type) {
 
 void Bindings::forget(const std::string& name) {
     for (size_t i = mUniforms.size(); i-- > 0;)
-        if (mUniforms[i].name == name) mUniforms.erase(mUniforms.begin() + static_cast<std::ptrdiff_t>(i));
+        if (mUniforms[i].name == name)
+            mUniforms.erase(mUniforms.begin() + static_cast<std::ptrdiff_t>(i));
     for (size_t i = mVaryings.size(); i-- > 0;)
-        if (mVaryings[i].name == name) mVaryings.erase(mVaryings.begin() + static_cast<std::ptrdiff_t>(i));
+        if (mVaryings[i].name == name)
+            mVaryings.erase(mVaryings.begin() + static_cast<std::ptrdiff_t>(i));
 }
 
 void Bindings::setUniform(const std::string& name, std::vector<double> value) {
@@ -212,8 +218,10 @@ void Bindings::addPoints(const fields::PointSet& points) {
         }
         std::vector<double>& aos = mStorage.emplace_back(n * static_cast<size_t>(width));
         for (int k = 0; k < width; ++k) {
-            const std::vector<double>& col = points.columns[static_cast<size_t>(pv.columns[static_cast<size_t>(k)])];
-            for (size_t i = 0; i < n; ++i) aos[i * static_cast<size_t>(width) + static_cast<size_t>(k)] = col[i];
+            const std::vector<double>& col =
+                points.columns[static_cast<size_t>(pv.columns[static_cast<size_t>(k)])];
+            for (size_t i = 0; i < n; ++i)
+                aos[i * static_cast<size_t>(width) + static_cast<size_t>(k)] = col[i];
         }
         setVarying(pv.name, width, aos.data(), width, 1);
     }
@@ -221,8 +229,10 @@ void Bindings::addPoints(const fields::PointSet& points) {
 
 void Bindings::addSets(const std::vector<SetValue>& sets) {
     for (const SetValue& s : sets) {
-        if (s.isString) setUniformString(s.name, s.text);
-        else setUniform(s.name, s.value);
+        if (s.isString)
+            setUniformString(s.name, s.text);
+        else
+            setUniform(s.name, s.value);
     }
 }
 
@@ -233,14 +243,15 @@ void Bindings::fillRequest(runtime::EvalRequest& request) const {
 
 // ---- compiling, points, output ----
 
-std::shared_ptr<const runtime::Program> compileAndReport(const lang::SourceFile& source,
-                                                         const std::vector<lang::HostVariable>& variables,
-                                                         int wantWidth) {
+std::shared_ptr<const runtime::Program>
+compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
+                 int wantWidth) {
     runtime::CompileSettings settings;
     settings.variables = variables;
     settings.wantWidth = wantWidth;
     lang::DiagnosticSink sink;
-    std::shared_ptr<const runtime::Program> program = runtime::Program::compile(source, settings, sink);
+    std::shared_ptr<const runtime::Program> program =
+        runtime::Program::compile(source, settings, sink);
     if (!sink.diagnostics().empty()) {
         lang::RenderOptions options;
         options.color = useColor();
@@ -297,11 +308,21 @@ std::string jsonString(const std::string& s) {
     std::string out = "\"";
     for (unsigned char c : s) {
         switch (c) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\t': out += "\\t"; break;
-        case '\r': out += "\\r"; break;
+        case '"':
+            out += "\\\"";
+            break;
+        case '\\':
+            out += "\\\\";
+            break;
+        case '\n':
+            out += "\\n";
+            break;
+        case '\t':
+            out += "\\t";
+            break;
+        case '\r':
+            out += "\\r";
+            break;
         default:
             if (c < 0x20) {
                 char buf[8];
@@ -347,11 +368,12 @@ std::string wrapHelp(const std::string& text, size_t width) {
 }
 
 void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType) {
-    CLI::Option* file = app.add_option("file", options.file,
-                                       "Expression file (.se); '-' reads it from stdin")
-                             ->type_name("FILE");
+    CLI::Option* file =
+        app.add_option("file", options.file, "Expression file (.se); '-' reads it from stdin")
+            ->type_name("FILE");
     CLI::Option* expr =
-        app.add_option("-e,--expr", options.expr, "Expression text instead of a file")->type_name("EXPR");
+        app.add_option("-e,--expr", options.expr, "Expression text instead of a file")
+            ->type_name("EXPR");
     file->excludes(expr);
     expr->excludes(file);
     app.add_option("--set", options.sets,

@@ -55,8 +55,8 @@ public:
     void setUniformString(const std::string& name, std::string text);
     // Component k of point i at data[i * pointStride + k * compStride]; `data` must outlive
     // the evaluation.
-    void setVarying(const std::string& name, int width, const double* data, std::ptrdiff_t pointStride,
-                    std::ptrdiff_t compStride);
+    void setVarying(const std::string& name, int width, const double* data,
+                    std::ptrdiff_t pointStride, std::ptrdiff_t compStride);
     // Every column of `points` as a varying variable (P from x,y,z, ...); multi-component
     // variables are interleaved into storage owned here. `points` must outlive evaluation.
     void addPoints(const fields::PointSet& points);
@@ -77,9 +77,9 @@ private:
 
 // Compiles `source`, printing every diagnostic (errors and warnings) to stderr. Null on
 // errors.
-std::shared_ptr<const runtime::Program> compileAndReport(const lang::SourceFile& source,
-                                                         const std::vector<lang::HostVariable>& variables,
-                                                         int wantWidth);
+std::shared_ptr<const runtime::Program>
+compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
+                 int wantWidth);
 
 // Reads a point file, printing IoError::render() on failure; returns an exit code.
 int loadPoints(const std::string& path, fields::PointSet& points);

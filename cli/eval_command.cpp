@@ -17,13 +17,20 @@ namespace {
 // neither names a known format.
 bool chooseFormat(const EvalOptions& o, fields::PointFormat& format) {
     if (!o.format.empty()) {
-        if (o.format == "csv") format = fields::PointFormat::Csv;
-        else if (o.format == "ply") format = fields::PointFormat::Ply;
-        else if (o.format == "ply-ascii") format = fields::PointFormat::PlyAscii;
-        else if (o.format == "json") format = fields::PointFormat::Json;
-        else if (o.format == "npy") format = fields::PointFormat::Npy;
-        else if (o.format == "obj") format = fields::PointFormat::Obj;
-        else return false; // CLI11 has already checked the name
+        if (o.format == "csv")
+            format = fields::PointFormat::Csv;
+        else if (o.format == "ply")
+            format = fields::PointFormat::Ply;
+        else if (o.format == "ply-ascii")
+            format = fields::PointFormat::PlyAscii;
+        else if (o.format == "json")
+            format = fields::PointFormat::Json;
+        else if (o.format == "npy")
+            format = fields::PointFormat::Npy;
+        else if (o.format == "obj")
+            format = fields::PointFormat::Obj;
+        else
+            return false; // CLI11 has already checked the name
         return true;
     }
     format = fields::PointFormat::Csv;
@@ -44,8 +51,9 @@ std::vector<std::string> resultColumns(int width) {
 }
 
 template <class T>
-runtime::EvalResult evaluateInto(const runtime::Program& program, const runtime::EvalRequest& request,
-                                 int width, std::vector<double>& values, std::vector<std::string>& strings) {
+runtime::EvalResult evaluateInto(const runtime::Program& program,
+                                 const runtime::EvalRequest& request, int width,
+                                 std::vector<double>& values, std::vector<std::string>& strings) {
     std::vector<T> buffer(request.count * static_cast<size_t>(std::max(width, 1)));
     runtime::EvalOutput<T> out;
     out.data = buffer.data();
@@ -64,12 +72,14 @@ int reportNonFinite(const lang::SourceFile& source, const runtime::EvalResult& r
     lang::RenderOptions options;
     options.color = useColor();
     for (const lang::Diagnostic& d : r.diagnostics) {
-        if (d.span.begin == 0 && d.span.end == 0) printError(d.message);
-        else std::cerr << lang::renderDiagnostic(source, d, options);
+        if (d.span.begin == 0 && d.span.end == 0)
+            printError(d.message);
+        else
+            std::cerr << lang::renderDiagnostic(source, d, options);
     }
     printError(std::to_string(r.nonFinite) + " of " + std::to_string(count) +
-               " point(s) gave a non-finite result (first: point " + std::to_string(r.firstBadPoint) +
-               "); nothing was written");
+               " point(s) gave a non-finite result (first: point " +
+               std::to_string(r.firstBadPoint) + "); nothing was written");
     return kExitNumeric;
 }
 
@@ -91,7 +101,8 @@ int runEval(const EvalOptions& o) {
     if (havePoints) {
         fields::PointFormat inFormat;
         if (o.points != "-" && !fields::formatFromPath(o.points, inFormat)) {
-            printError("cannot tell the point file type of '" + o.points + "': use .csv, .ply or .obj");
+            printError("cannot tell the point file type of '" + o.points +
+                       "': use .csv, .ply or .obj");
             return kExitUsage;
         }
         if (!chooseFormat(o, format)) return kExitUsage;
@@ -144,8 +155,9 @@ int runEval(const EvalOptions& o) {
     const int width = program->resultIsString() ? 1 : program->resultWidth();
     std::vector<double> values;
     std::vector<std::string> strings;
-    runtime::EvalResult r = asFloat ? evaluateInto<float>(*program, request, width, values, strings)
-                                    : evaluateInto<double>(*program, request, width, values, strings);
+    runtime::EvalResult r = asFloat
+                                ? evaluateInto<float>(*program, request, width, values, strings)
+                                : evaluateInto<double>(*program, request, width, values, strings);
     if (!r.messages.empty()) std::cerr << r.messages << std::flush;
     if (!r.ok) {
         printError("cannot evaluate " + source.name() + ": " + r.error);
@@ -173,14 +185,18 @@ int runEval(const EvalOptions& o) {
     // The points with the result columns added (replacing columns of the same names).
     std::vector<int> added;
     for (const std::string& name : resultColumns(width)) added.push_back(points.addColumn(name));
-    if (points.float32.size() < points.names.size()) points.float32.resize(points.names.size(), false);
+    if (points.float32.size() < points.names.size())
+        points.float32.resize(points.names.size(), false);
     const size_t n = points.size();
     for (int k = 0; k < width; ++k) {
-        std::vector<double>& col = points.columns[static_cast<size_t>(added[static_cast<size_t>(k)])];
-        for (size_t i = 0; i < n; ++i) col[i] = values[i * static_cast<size_t>(width) + static_cast<size_t>(k)];
+        std::vector<double>& col =
+            points.columns[static_cast<size_t>(added[static_cast<size_t>(k)])];
+        for (size_t i = 0; i < n; ++i)
+            col[i] = values[i * static_cast<size_t>(width) + static_cast<size_t>(k)];
         points.float32[static_cast<size_t>(added[static_cast<size_t>(k)])] = asFloat;
     }
-    const std::vector<int> npyColumns = format == fields::PointFormat::Npy ? added : std::vector<int>{};
+    const std::vector<int> npyColumns =
+        format == fields::PointFormat::Npy ? added : std::vector<int>{};
     if (toStdout) {
         fields::IoError e = fields::writePoints(std::cout, points, format, npyColumns);
         std::cout.flush();
@@ -210,11 +226,21 @@ Command addEvalCommand(CLI::App& app) {
                     "(ascii or binary), .obj vertices; '-' reads CSV from stdin. Every column "
                     "becomes a varying variable: $P from x,y,z, $N from nx,ny,nz, others by name")
         ->type_name("IN");
-    sub->add_option_function<double>("--time", [o](const double& v) { o->time = v; o->hasTime = true; },
-                                     "$t in seconds (default: --frame / --fps, else 0)")
+    sub->add_option_function<double>(
+           "--time",
+           [o](const double& v) {
+               o->time = v;
+               o->hasTime = true;
+           },
+           "$t in seconds (default: --frame / --fps, else 0)")
         ->type_name("T");
-    sub->add_option_function<double>("--frame", [o](const double& v) { o->frame = v; o->hasFrame = true; },
-                                      "$frame (default: --time * --fps)")
+    sub->add_option_function<double>(
+           "--frame",
+           [o](const double& v) {
+               o->frame = v;
+               o->hasFrame = true;
+           },
+           "$frame (default: --time * --fps)")
         ->type_name("F");
     sub->add_option("--fps", o->fps, "$fps, frames per second")->capture_default_str();
     sub->add_option("--precision", o->precision, "Evaluate in float or double")
@@ -235,7 +261,8 @@ Command addEvalCommand(CLI::App& app) {
                     "columns, float32, shape (N,3) or (N,)")
         ->type_name("FMT")
         ->check(CLI::IsMember({"csv", "ply", "ply-ascii", "json", "npy", "obj"}));
-    sub->add_flag("--disasm", o->disasm, "Print the compiled program's bytecode instead of evaluating");
+    sub->add_flag("--disasm", o->disasm,
+                  "Print the compiled program's bytecode instead of evaluating");
     sub->add_flag("--checked", o->checked,
                   "Check every result for NaN/infinity: report the operation that produced the "
                   "first one and exit 4 without writing output");

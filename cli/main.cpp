@@ -17,16 +17,19 @@
 // newline.
 static void wrapAllHelp(CLI::App& app, bool root = true) {
     if (!root) app.description(gale::cli::wrapHelp(app.get_description()));
-    if (!app.get_footer().empty() && app.get_footer().back() != '\n') app.footer(app.get_footer() + "\n");
+    if (!app.get_footer().empty() && app.get_footer().back() != '\n')
+        app.footer(app.get_footer() + "\n");
     for (CLI::Option* opt : app.get_options(std::function<bool(CLI::Option*)>()))
         opt->description(gale::cli::wrapHelp(opt->get_description()));
-    for (CLI::App* sub : app.get_subcommands(std::function<bool(CLI::App*)>([](CLI::App*) { return true; })))
+    for (CLI::App* sub :
+         app.get_subcommands(std::function<bool(CLI::App*)>([](CLI::App*) { return true; })))
         wrapAllHelp(*sub, false);
 }
 
 int main(int argc, char** argv) {
     using namespace gale::cli;
-    CLI::App app("gale " GALE_VERSION ": SeExpr2-compatible wind expressions for cloth and hair", "gale");
+    CLI::App app("gale " GALE_VERSION ": SeExpr2-compatible wind expressions for cloth and hair",
+                 "gale");
     app.set_version_flag("--version", "gale " GALE_VERSION);
     app.require_subcommand(1);
     app.footer("Data goes to stdout (or -o), messages to stderr; '-' means stdin or stdout.\n"

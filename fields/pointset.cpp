@@ -109,16 +109,24 @@ static std::string lowerExtension(const std::string& path) {
 
 bool formatFromPath(const std::string& path, PointFormat& out) {
     std::string ext = lowerExtension(path);
-    if (ext == ".csv") out = PointFormat::Csv;
-    else if (ext == ".ply") out = PointFormat::Ply;
-    else if (ext == ".obj") out = PointFormat::Obj;
-    else if (ext == ".json") out = PointFormat::Json;
-    else if (ext == ".npy") out = PointFormat::Npy;
-    else return false;
+    if (ext == ".csv")
+        out = PointFormat::Csv;
+    else if (ext == ".ply")
+        out = PointFormat::Ply;
+    else if (ext == ".obj")
+        out = PointFormat::Obj;
+    else if (ext == ".json")
+        out = PointFormat::Json;
+    else if (ext == ".npy")
+        out = PointFormat::Npy;
+    else
+        return false;
     return true;
 }
 
-static std::string errnoText(int err) { return err ? std::strerror(err) : "unknown error"; }
+static std::string errnoText(int err) {
+    return err ? std::strerror(err) : "unknown error";
+}
 
 IoError readPoints(const std::string& path, PointSet& out, std::istream* stdinStream) {
     out = PointSet{};
@@ -130,16 +138,19 @@ IoError readPoints(const std::string& path, PointSet& out, std::istream* stdinSt
     if (!formatFromPath(path, format))
         return dataError(path, 0, 0, "unknown point file type: use .csv, .ply or .obj");
     if (format == PointFormat::Json || format == PointFormat::Npy)
-        return dataError(path, 0, 0, "points cannot be read from " + lowerExtension(path) +
-                                         " files: use .csv, .ply or .obj");
+        return dataError(path, 0, 0,
+                         "points cannot be read from " + lowerExtension(path) +
+                             " files: use .csv, .ply or .obj");
     std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) return ioError(path, "cannot read: is a directory");
+    if (std::filesystem::is_directory(path, ec))
+        return ioError(path, "cannot read: is a directory");
     if (format == PointFormat::Obj) return readPointsObj(path, out);
 
     errno = 0;
     std::ifstream in(path, std::ios::binary);
     if (!in) return ioError(path, "cannot open: " + errnoText(errno));
-    IoError e = format == PointFormat::Csv ? readPointsCsv(in, path, out) : readPointsPly(in, path, out);
+    IoError e =
+        format == PointFormat::Csv ? readPointsCsv(in, path, out) : readPointsPly(in, path, out);
     if (!e && in.bad()) return ioError(path, "read failed: " + errnoText(errno));
     return e;
 }
@@ -215,7 +226,8 @@ IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet
                 if (parseNumber(name, dummy).empty())
                     return dataError(displayName, lineNo, fields[i].col,
                                      "the first line must be a header naming the columns "
-                                     "(like x,y,z), found the number '" + std::string(name) + "'");
+                                     "(like x,y,z), found the number '" +
+                                         std::string(name) + "'");
                 if (!seen.insert(std::string(name)).second)
                     return dataError(displayName, lineNo, fields[i].col,
                                      "duplicate column name '" + std::string(name) + "'");
@@ -239,8 +251,9 @@ IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet
     }
     if (in.bad()) return ioError(displayName, "read failed: " + errnoText(errno));
     if (!haveHeader)
-        return dataError(displayName, 0, 0,
-                         "no header line: a CSV point file starts with the column names, e.g. x,y,z");
+        return dataError(
+            displayName, 0, 0,
+            "no header line: a CSV point file starts with the column names, e.g. x,y,z");
     return {};
 }
 
@@ -313,11 +326,21 @@ void appendJsonString(std::string& out, const std::string& s) {
     out += '"';
     for (unsigned char ch : s) {
         switch (ch) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\t': out += "\\t"; break;
-        case '\r': out += "\\r"; break;
+        case '"':
+            out += "\\\"";
+            break;
+        case '\\':
+            out += "\\\\";
+            break;
+        case '\n':
+            out += "\\n";
+            break;
+        case '\t':
+            out += "\\t";
+            break;
+        case '\r':
+            out += "\\r";
+            break;
         default:
             if (ch < 0x20) {
                 char esc[8];
@@ -346,8 +369,10 @@ IoError writeJson(std::ostream& out, const PointSet& ps) {
             if (c) buf += ", ";
             buf += keys[c];
             double v = ps.columns[c][i];
-            if (std::isfinite(v)) detail::appendNumber(buf, v, ps.isFloat32(static_cast<int>(c)));
-            else buf += "null";
+            if (std::isfinite(v))
+                detail::appendNumber(buf, v, ps.isFloat32(static_cast<int>(c)));
+            else
+                buf += "null";
         }
         buf += i + 1 < n ? "},\n" : "}\n";
         if (buf.size() > (1u << 16)) {
@@ -376,8 +401,9 @@ IoError writeNpy(std::ostream& out, const PointSet& ps, const std::vector<int>& 
         if (c < 0 || static_cast<size_t>(c) >= ps.columns.size())
             return dataError("", 0, 0, "npy column " + std::to_string(c) + " does not exist");
     size_t n = ps.size();
-    std::string shape = cols.size() == 1 ? "(" + std::to_string(n) + ",)"
-                                         : "(" + std::to_string(n) + ", " + std::to_string(cols.size()) + ")";
+    std::string shape = cols.size() == 1
+                            ? "(" + std::to_string(n) + ",)"
+                            : "(" + std::to_string(n) + ", " + std::to_string(cols.size()) + ")";
     std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape + ", }";
     // Magic (6) + version (2) + length (2) + header, padded with spaces so the data starts at
     // a multiple of 64 bytes, and ended by '\n'.
@@ -401,8 +427,7 @@ IoError writeNpy(std::ostream& out, const PointSet& ps, const std::vector<int>& 
 
 IoError writeObj(std::ostream& out, const PointSet& ps) {
     int x = ps.find("x"), y = ps.find("y"), z = ps.find("z");
-    if (x < 0 || y < 0 || z < 0)
-        return dataError("", 0, 0, "an OBJ file needs x, y and z columns");
+    if (x < 0 || y < 0 || z < 0) return dataError("", 0, 0, "an OBJ file needs x, y and z columns");
     std::string buf = "# written by gale\n";
     size_t n = ps.size();
     for (size_t i = 0; i < n; ++i) {
@@ -429,12 +454,24 @@ IoError writePoints(std::ostream& out, const PointSet& points, PointFormat forma
                     const std::vector<int>& npyColumns) {
     IoError e;
     switch (format) {
-    case PointFormat::Csv: e = writeCsv(out, points); break;
-    case PointFormat::Ply: e = detail::writePly(out, points, true); break;
-    case PointFormat::PlyAscii: e = detail::writePly(out, points, false); break;
-    case PointFormat::Obj: e = writeObj(out, points); break;
-    case PointFormat::Json: e = writeJson(out, points); break;
-    case PointFormat::Npy: e = writeNpy(out, points, npyColumns); break;
+    case PointFormat::Csv:
+        e = writeCsv(out, points);
+        break;
+    case PointFormat::Ply:
+        e = detail::writePly(out, points, true);
+        break;
+    case PointFormat::PlyAscii:
+        e = detail::writePly(out, points, false);
+        break;
+    case PointFormat::Obj:
+        e = writeObj(out, points);
+        break;
+    case PointFormat::Json:
+        e = writeJson(out, points);
+        break;
+    case PointFormat::Npy:
+        e = writeNpy(out, points, npyColumns);
+        break;
     }
     if (e) return e;
     if (!out) return ioError("", "write failed: " + errnoText(errno));

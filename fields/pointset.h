@@ -11,7 +11,7 @@
 namespace gale::fields {
 
 struct PointSet {
-    std::vector<std::string> names;          // column names, in file order
+    std::vector<std::string> names;           // column names, in file order
     std::vector<std::vector<double>> columns; // all of the same length
     std::vector<std::vector<int>> faces;      // polygon faces (PLY face element / OBJ f), kept
     bool plyBinary = false;                   // read from a binary PLY

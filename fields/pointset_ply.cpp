@@ -25,36 +25,55 @@ namespace {
 enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
 bool plyTypeFromName(std::string_view s, PlyType& t) {
-    if (s == "char" || s == "int8") t = PlyType::Int8;
-    else if (s == "uchar" || s == "uint8") t = PlyType::UInt8;
-    else if (s == "short" || s == "int16") t = PlyType::Int16;
-    else if (s == "ushort" || s == "uint16") t = PlyType::UInt16;
-    else if (s == "int" || s == "int32") t = PlyType::Int32;
-    else if (s == "uint" || s == "uint32") t = PlyType::UInt32;
-    else if (s == "float" || s == "float32") t = PlyType::Float32;
-    else if (s == "double" || s == "float64") t = PlyType::Float64;
-    else return false;
+    if (s == "char" || s == "int8")
+        t = PlyType::Int8;
+    else if (s == "uchar" || s == "uint8")
+        t = PlyType::UInt8;
+    else if (s == "short" || s == "int16")
+        t = PlyType::Int16;
+    else if (s == "ushort" || s == "uint16")
+        t = PlyType::UInt16;
+    else if (s == "int" || s == "int32")
+        t = PlyType::Int32;
+    else if (s == "uint" || s == "uint32")
+        t = PlyType::UInt32;
+    else if (s == "float" || s == "float32")
+        t = PlyType::Float32;
+    else if (s == "double" || s == "float64")
+        t = PlyType::Float64;
+    else
+        return false;
     return true;
 }
 
 size_t plyTypeSize(PlyType t) {
     switch (t) {
-    case PlyType::Int8: case PlyType::UInt8: return 1;
-    case PlyType::Int16: case PlyType::UInt16: return 2;
-    case PlyType::Int32: case PlyType::UInt32: case PlyType::Float32: return 4;
-    case PlyType::Float64: return 8;
+    case PlyType::Int8:
+    case PlyType::UInt8:
+        return 1;
+    case PlyType::Int16:
+    case PlyType::UInt16:
+        return 2;
+    case PlyType::Int32:
+    case PlyType::UInt32:
+    case PlyType::Float32:
+        return 4;
+    case PlyType::Float64:
+        return 8;
     }
     return 1;
 }
 
-bool plyTypeIsInteger(PlyType t) { return t != PlyType::Float32 && t != PlyType::Float64; }
+bool plyTypeIsInteger(PlyType t) {
+    return t != PlyType::Float32 && t != PlyType::Float64;
+}
 
 struct PlyProperty {
     std::string name;
     PlyType type = PlyType::Float32;
     bool isList = false;
     PlyType countType = PlyType::UInt8;
-    int column = -1;      // vertex: destination column
+    int column = -1;          // vertex: destination column
     bool faceIndices = false; // face: the vertex_indices list
 };
 
@@ -92,7 +111,8 @@ class PlyBodyReader {
 public:
     PlyBodyReader(std::string data, PlyEncoding enc, int firstLine)
         : mData(std::move(data)), mEncoding(enc), mLine(firstLine),
-          mSwap(enc != PlyEncoding::Ascii && (enc == PlyEncoding::BinaryLE) != hostIsLittleEndian()) {}
+          mSwap(enc != PlyEncoding::Ascii &&
+                (enc == PlyEncoding::BinaryLE) != hostIsLittleEndian()) {}
 
     // false at end of data (ascii: also on a malformed token, with `mBadToken` set).
     bool read(PlyType t, double& v) {
@@ -114,14 +134,48 @@ private:
         if (mSwap)
             for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
         switch (t) {
-        case PlyType::Int8: { int8_t x; std::memcpy(&x, b, 1); v = x; break; }
-        case PlyType::UInt8: v = b[0]; break;
-        case PlyType::Int16: { int16_t x; std::memcpy(&x, b, 2); v = x; break; }
-        case PlyType::UInt16: { uint16_t x; std::memcpy(&x, b, 2); v = x; break; }
-        case PlyType::Int32: { int32_t x; std::memcpy(&x, b, 4); v = x; break; }
-        case PlyType::UInt32: { uint32_t x; std::memcpy(&x, b, 4); v = x; break; }
-        case PlyType::Float32: { float x; std::memcpy(&x, b, 4); v = x; break; }
-        case PlyType::Float64: std::memcpy(&v, b, 8); break;
+        case PlyType::Int8: {
+            int8_t x;
+            std::memcpy(&x, b, 1);
+            v = x;
+            break;
+        }
+        case PlyType::UInt8:
+            v = b[0];
+            break;
+        case PlyType::Int16: {
+            int16_t x;
+            std::memcpy(&x, b, 2);
+            v = x;
+            break;
+        }
+        case PlyType::UInt16: {
+            uint16_t x;
+            std::memcpy(&x, b, 2);
+            v = x;
+            break;
+        }
+        case PlyType::Int32: {
+            int32_t x;
+            std::memcpy(&x, b, 4);
+            v = x;
+            break;
+        }
+        case PlyType::UInt32: {
+            uint32_t x;
+            std::memcpy(&x, b, 4);
+            v = x;
+            break;
+        }
+        case PlyType::Float32: {
+            float x;
+            std::memcpy(&x, b, 4);
+            v = x;
+            break;
+        }
+        case PlyType::Float64:
+            std::memcpy(&v, b, 8);
+            break;
         }
         return true;
     }
@@ -140,7 +194,8 @@ private:
         }
         if (mPos >= mData.size()) return false;
         size_t start = mPos;
-        while (mPos < mData.size() && !std::isspace(static_cast<unsigned char>(mData[mPos]))) ++mPos;
+        while (mPos < mData.size() && !std::isspace(static_cast<unsigned char>(mData[mPos])))
+            ++mPos;
         mTokenCol = static_cast<int>(start - mLineStart + 1);
         const char* a = mData.data() + start;
         const char* e = mData.data() + mPos;
@@ -193,32 +248,41 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
         }
         if (key == "format") {
             if (w.size() != 3)
-                return dataError(name, lineNo, 1, "expected 'format <ascii|binary_little_endian|"
-                                                  "binary_big_endian> 1.0'");
-            if (w[1] == "ascii") encoding = PlyEncoding::Ascii;
-            else if (w[1] == "binary_little_endian") encoding = PlyEncoding::BinaryLE;
-            else if (w[1] == "binary_big_endian") encoding = PlyEncoding::BinaryBE;
+                return dataError(name, lineNo, 1,
+                                 "expected 'format <ascii|binary_little_endian|"
+                                 "binary_big_endian> 1.0'");
+            if (w[1] == "ascii")
+                encoding = PlyEncoding::Ascii;
+            else if (w[1] == "binary_little_endian")
+                encoding = PlyEncoding::BinaryLE;
+            else if (w[1] == "binary_big_endian")
+                encoding = PlyEncoding::BinaryBE;
             else
-                return dataError(name, lineNo, 8, "unknown PLY format '" + std::string(w[1]) +
-                                                      "': expected ascii, binary_little_endian "
-                                                      "or binary_big_endian");
+                return dataError(name, lineNo, 8,
+                                 "unknown PLY format '" + std::string(w[1]) +
+                                     "': expected ascii, binary_little_endian "
+                                     "or binary_big_endian");
             if (w[2] != "1.0" && w[2] != "1")
-                return dataError(name, lineNo, 1, "unsupported PLY version '" + std::string(w[2]) +
-                                                      "' (only 1.0 is supported)");
+                return dataError(name, lineNo, 1,
+                                 "unsupported PLY version '" + std::string(w[2]) +
+                                     "' (only 1.0 is supported)");
             haveFormat = true;
         } else if (key == "element") {
             unsigned long long count = 0;
             if (w.size() != 3)
                 return dataError(name, lineNo, 1, "expected 'element <name> <count>'");
-            std::from_chars_result r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), count);
+            std::from_chars_result r =
+                std::from_chars(w[2].data(), w[2].data() + w[2].size(), count);
             if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
-                return dataError(name, lineNo, 1, "element count must be a non-negative integer, found '" +
-                                                      std::string(w[2]) + "'");
+                return dataError(name, lineNo, 1,
+                                 "element count must be a non-negative integer, found '" +
+                                     std::string(w[2]) + "'");
             for (const PlyElement& e : elements)
                 if (e.name == w[1])
-                    return dataError(name, lineNo, 1, "element '" + std::string(w[1]) +
-                                                          "' is declared twice (first on line " +
-                                                          std::to_string(e.line) + ")");
+                    return dataError(name, lineNo, 1,
+                                     "element '" + std::string(w[1]) +
+                                         "' is declared twice (first on line " +
+                                         std::to_string(e.line) + ")");
             PlyElement e;
             e.name = std::string(w[1]);
             e.count = static_cast<size_t>(count);
@@ -235,8 +299,9 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                                      "expected 'property list <count type> <item type> <name>'");
                 p.isList = true;
                 if (!plyTypeFromName(w[2], p.countType) || !plyTypeIsInteger(p.countType))
-                    return dataError(name, lineNo, 1, "bad list count type '" + std::string(w[2]) +
-                                                          "': expected an integer type such as uchar");
+                    return dataError(name, lineNo, 1,
+                                     "bad list count type '" + std::string(w[2]) +
+                                         "': expected an integer type such as uchar");
                 typeAt = 3;
             } else if (w.size() != 3) {
                 return dataError(name, lineNo, 1, "expected 'property <type> <name>'");
@@ -249,18 +314,21 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
             p.name = std::string(w[typeAt + 1]);
             for (const PlyProperty& q : elements.back().props)
                 if (q.name == p.name)
-                    return dataError(name, lineNo, 1, "property '" + p.name + "' of element '" +
-                                                          elements.back().name + "' is declared twice");
+                    return dataError(name, lineNo, 1,
+                                     "property '" + p.name + "' of element '" +
+                                         elements.back().name + "' is declared twice");
             elements.back().props.push_back(std::move(p));
         } else {
-            return dataError(name, lineNo, 1, "unknown PLY header line '" + std::string(key) +
-                                                  "': expected format, element, property, "
-                                                  "comment or end_header");
+            return dataError(name, lineNo, 1,
+                             "unknown PLY header line '" + std::string(key) +
+                                 "': expected format, element, property, "
+                                 "comment or end_header");
         }
     }
     if (in.bad()) return ioError(name, "read failed: " + std::string(std::strerror(errno)));
     if (!ended)
-        return dataError(name, lineNo, 0, "unexpected end of file in the PLY header: no 'end_header'");
+        return dataError(name, lineNo, 0,
+                         "unexpected end of file in the PLY header: no 'end_header'");
     if (!haveFormat) return dataError(name, lineNo, 1, "the PLY header has no 'format' line");
 
     // Columns from the vertex element's scalar properties; the face element's index list.
@@ -282,8 +350,7 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                 }
         }
     }
-    if (!vertex)
-        return dataError(name, lineNo, 0, "the PLY file has no 'vertex' element");
+    if (!vertex) return dataError(name, lineNo, 0, "the PLY file has no 'vertex' element");
     size_t vertexCount = vertex->count;
 
     // The body: read it all, then walk the elements in order.
@@ -303,13 +370,16 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
         if (!e.props.empty()) {
             size_t minSize = 0;
             for (const PlyProperty& p : e.props)
-                minSize += body.ascii() ? 2 : p.isList ? plyTypeSize(p.countType) : plyTypeSize(p.type);
+                minSize += body.ascii() ? 2
+                           : p.isList   ? plyTypeSize(p.countType)
+                                        : plyTypeSize(p.type);
             if (e.count > (body.remaining() + 1) / minSize)
-                return dataError(name, body.ascii() ? body.line() : 0, 0,
-                                 std::string(body.ascii() ? "unexpected end of file" : "truncated binary data") +
-                                     ": the header (line " + std::to_string(e.line) + ") declares " +
-                                     std::to_string(e.count) + " " + e.name +
-                                     " elements, more than the file holds");
+                return dataError(
+                    name, body.ascii() ? body.line() : 0, 0,
+                    std::string(body.ascii() ? "unexpected end of file" : "truncated binary data") +
+                        ": the header (line " + std::to_string(e.line) + ") declares " +
+                        std::to_string(e.count) + " " + e.name +
+                        " elements, more than the file holds");
         }
         bool isVertex = &e == vertex;
         if (isVertex) out.columns.assign(out.names.size(), std::vector<double>(e.count));
@@ -317,18 +387,21 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
         for (size_t i = 0; i < e.count; ++i) {
             for (const PlyProperty& p : e.props) {
                 auto fail = [&]() {
-                    std::string where = e.name + " " + std::to_string(i) + " (property '" + p.name + "')";
+                    std::string where =
+                        e.name + " " + std::to_string(i) + " (property '" + p.name + "')";
                     if (body.ascii() && !body.badToken().empty())
                         return dataError(name, body.line(), body.col(),
-                                         std::string("expected a number for ") + where + ", found '" +
-                                             body.badToken() + "'");
+                                         std::string("expected a number for ") + where +
+                                             ", found '" + body.badToken() + "'");
                     if (body.ascii())
                         return dataError(name, body.line(), 0,
-                                         "unexpected end of file in " + where + ": the header says " +
-                                             std::to_string(e.count) + " " + e.name + " elements");
+                                         "unexpected end of file in " + where +
+                                             ": the header says " + std::to_string(e.count) + " " +
+                                             e.name + " elements");
                     return dataError(name, 0, 0,
-                                     std::string("truncated binary data: the file ends in ") + where +
-                                         " of " + std::to_string(e.count) + " " + e.name + " elements");
+                                     std::string("truncated binary data: the file ends in ") +
+                                         where + " of " + std::to_string(e.count) + " " + e.name +
+                                         " elements");
                 };
                 double v = 0.0;
                 if (!p.isList) {
@@ -338,9 +411,10 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                 }
                 if (!body.read(p.countType, v)) return fail();
                 if (!(v >= 0) || v != std::floor(v) || v > 1e9)
-                    return dataError(name, body.ascii() ? body.line() : 0, body.ascii() ? body.col() : 0,
-                                     "bad list length " + formatNumber(v) + " in " + e.name +
-                                         " " + std::to_string(i) + " (property '" + p.name + "')");
+                    return dataError(name, body.ascii() ? body.line() : 0,
+                                     body.ascii() ? body.col() : 0,
+                                     "bad list length " + formatNumber(v) + " in " + e.name + " " +
+                                         std::to_string(i) + " (property '" + p.name + "')");
                 size_t len = static_cast<size_t>(v);
                 std::vector<int> face;
                 if (p.faceIndices) face.reserve(len);
@@ -348,7 +422,8 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                     if (!body.read(p.type, v)) return fail();
                     if (!p.faceIndices) continue;
                     if (!(v >= 0) || v >= static_cast<double>(vertexCount) || v != std::floor(v))
-                        return dataError(name, body.ascii() ? body.line() : 0, body.ascii() ? body.col() : 0,
+                        return dataError(name, body.ascii() ? body.line() : 0,
+                                         body.ascii() ? body.col() : 0,
                                          e.name + " " + std::to_string(i) + " refers to vertex " +
                                              formatNumber(v) + ", but there are " +
                                              std::to_string(vertexCount) + " vertices");

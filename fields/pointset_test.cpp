@@ -22,8 +22,10 @@ PointSet readCsvText(const std::string& text, IoError* err = nullptr) {
     std::istringstream in(text);
     PointSet ps;
     IoError e = readPointsCsv(in, "t.csv", ps);
-    if (err) *err = e;
-    else REQUIRE_FALSE(e);
+    if (err)
+        *err = e;
+    else
+        REQUIRE_FALSE(e);
     return ps;
 }
 
@@ -31,8 +33,10 @@ PointSet readPlyText(const std::string& text, IoError* err = nullptr) {
     std::istringstream in(text);
     PointSet ps;
     IoError e = readPointsPly(in, "t.ply", ps);
-    if (err) *err = e;
-    else if (e) FAIL(e.render());
+    if (err)
+        *err = e;
+    else if (e)
+        FAIL(e.render());
     return ps;
 }
 
@@ -56,7 +60,8 @@ struct TempDir {
     std::filesystem::path path;
     TempDir() {
         path = std::filesystem::temp_directory_path() /
-               ("gale_pointset_test_" + std::to_string(::getpid()) + "_" + std::to_string(std::rand()));
+               ("gale_pointset_test_" + std::to_string(::getpid()) + "_" +
+                std::to_string(std::rand()));
         std::filesystem::create_directories(path);
     }
     ~TempDir() { std::filesystem::remove_all(path); }
@@ -98,7 +103,8 @@ TEST_CASE("formatNumber gives the shortest round-trip text", "[pointset]") {
 }
 
 TEST_CASE("CSV: header, rows, comments, blank lines, CRLF", "[pointset][csv]") {
-    PointSet ps = readCsvText("# a comment\r\nx, y ,z,u\r\n\r\n1,2,3,4\r\n  # indented comment\n+5,-6e1,.5,nan\n");
+    PointSet ps = readCsvText(
+        "# a comment\r\nx, y ,z,u\r\n\r\n1,2,3,4\r\n  # indented comment\n+5,-6e1,.5,nan\n");
     REQUIRE(ps.names == std::vector<std::string>{"x", "y", "z", "u"});
     REQUIRE(ps.size() == 2);
     CHECK(ps.columns[0] == std::vector<double>{1, 5});
@@ -173,7 +179,8 @@ TEST_CASE("PLY binary and ascii round trips with faces", "[pointset][ply]") {
     PointSet ps = sample();
     for (PointFormat f : {PointFormat::Ply, PointFormat::PlyAscii}) {
         std::string text = write(ps, f);
-        CHECK(text.find(f == PointFormat::Ply ? "binary_little_endian" : "format ascii") != std::string::npos);
+        CHECK(text.find(f == PointFormat::Ply ? "binary_little_endian" : "format ascii") !=
+              std::string::npos);
         CHECK(text.find("property float u\n") != std::string::npos);
         CHECK(text.find("property list uchar int vertex_indices") != std::string::npos);
         PointSet back = readPlyText(text);
@@ -186,27 +193,26 @@ TEST_CASE("PLY binary and ascii round trips with faces", "[pointset][ply]") {
 }
 
 TEST_CASE("PLY ascii with arbitrary properties and skipped elements", "[pointset][ply]") {
-    std::string text =
-        "ply\n"
-        "format ascii 1.0\n"
-        "comment made by hand\n"
-        "obj_info nothing\n"
-        "element vertex 2\n"
-        "property float32 x\nproperty float y\nproperty double z\n"
-        "property uchar red\nproperty short s\nproperty uint16 us\n"
-        "property list uchar int extra\n"
-        "property int8 c\n"
-        "element material 1\n"
-        "property list uint float values\nproperty int id\n"
-        "element face 2\n"
-        "property uchar flags\n"
-        "property list uchar uint vertex_index\n"
-        "end_header\n"
-        "0.1 2 3.25 255 -7 65535 2 10 11 -3\n"
-        "4 5 6 0 0 0 0 1\n"
-        "3 1.5 2.5 3.5 42\n"
-        "9 3 0 1 1\n"
-        "0 4 1 0 1 0\n";
+    std::string text = "ply\n"
+                       "format ascii 1.0\n"
+                       "comment made by hand\n"
+                       "obj_info nothing\n"
+                       "element vertex 2\n"
+                       "property float32 x\nproperty float y\nproperty double z\n"
+                       "property uchar red\nproperty short s\nproperty uint16 us\n"
+                       "property list uchar int extra\n"
+                       "property int8 c\n"
+                       "element material 1\n"
+                       "property list uint float values\nproperty int id\n"
+                       "element face 2\n"
+                       "property uchar flags\n"
+                       "property list uchar uint vertex_index\n"
+                       "end_header\n"
+                       "0.1 2 3.25 255 -7 65535 2 10 11 -3\n"
+                       "4 5 6 0 0 0 0 1\n"
+                       "3 1.5 2.5 3.5 42\n"
+                       "9 3 0 1 1\n"
+                       "0 4 1 0 1 0\n";
     PointSet ps = readPlyText(text);
     CHECK_FALSE(ps.plyBinary);
     REQUIRE(ps.names == std::vector<std::string>{"x", "y", "z", "red", "s", "us", "c"});
@@ -229,16 +235,30 @@ TEST_CASE("PLY ascii with arbitrary properties and skipped elements", "[pointset
 
 TEST_CASE("PLY binary big-endian and little-endian with mixed types", "[pointset][ply]") {
     for (bool big : {true, false}) {
-        std::string s = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+        std::string s = std::string("ply\nformat ") +
+                        (big ? "binary_big_endian" : "binary_little_endian") +
                         " 1.0\nelement vertex 2\nproperty double x\nproperty float y\n"
                         "property int z\nproperty uchar red\nproperty ushort w\n"
                         "element edge 1\nproperty list uchar int ends\n"
                         "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
         auto put = [&](auto v) { big ? putBE(s, v) : putLE(s, v); };
-        put(1.25); put(2.5f); put(int32_t(-3)); put(uint8_t(200)); put(uint16_t(60000));
-        put(-0.5); put(0.75f); put(int32_t(100000)); put(uint8_t(1)); put(uint16_t(2));
-        put(uint8_t(2)); put(int32_t(0)); put(int32_t(1));
-        put(uint8_t(3)); put(int32_t(1)); put(int32_t(0)); put(int32_t(1));
+        put(1.25);
+        put(2.5f);
+        put(int32_t(-3));
+        put(uint8_t(200));
+        put(uint16_t(60000));
+        put(-0.5);
+        put(0.75f);
+        put(int32_t(100000));
+        put(uint8_t(1));
+        put(uint16_t(2));
+        put(uint8_t(2));
+        put(int32_t(0));
+        put(int32_t(1));
+        put(uint8_t(3));
+        put(int32_t(1));
+        put(int32_t(0));
+        put(int32_t(1));
         PointSet ps = readPlyText(s);
         CHECK(ps.plyBinary);
         REQUIRE(ps.names == std::vector<std::string>{"x", "y", "z", "red", "w"});
@@ -263,7 +283,8 @@ TEST_CASE("PLY errors", "[pointset][ply]") {
     CHECK(e.line == 4);
     CHECK(e.message.find("flot") != std::string::npos);
 
-    readPlyText("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nbogus\nend_header\n", &e);
+    readPlyText("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nbogus\nend_header\n",
+                &e);
     REQUIRE(e);
     CHECK(e.line == 5);
 
@@ -285,7 +306,8 @@ TEST_CASE("PLY errors", "[pointset][ply]") {
 
     // ascii body: a bad number at its line and column; a short file.
     readPlyText("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                "end_header\n1 2\n3 oops\n", &e);
+                "end_header\n1 2\n3 oops\n",
+                &e);
     REQUIRE(e);
     CHECK(e.line == 8);
     CHECK(e.col == 3);
@@ -293,12 +315,14 @@ TEST_CASE("PLY errors", "[pointset][ply]") {
     CHECK(e.message.find("vertex 1") != std::string::npos);
 
     readPlyText("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                "end_header\n1 2\n3 4\n5\n", &e);
+                "end_header\n1 2\n3 4\n5\n",
+                &e);
     REQUIRE(e);
     CHECK(e.message.find("end of file") != std::string::npos);
 
     // binary: truncated data.
-    std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n";
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nend_header\n";
     putLE(s, 1.0f);
     putLE(s, uint16_t(0));
     readPlyText(s, &e);
@@ -306,14 +330,17 @@ TEST_CASE("PLY errors", "[pointset][ply]") {
     CHECK(e.message.find("truncated") != std::string::npos);
 
     // a count far beyond the data is caught before allocating.
-    readPlyText("ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
-                "end_header\n", &e);
+    readPlyText(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+        "end_header\n",
+        &e);
     REQUIRE(e);
     CHECK(e.message.find("truncated") != std::string::npos);
 
     // face index out of range.
     readPlyText("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement face 1\n"
-                "property list uchar int vertex_indices\nend_header\n0\n3 0 0 5\n", &e);
+                "property list uchar int vertex_indices\nend_header\n0\n3 0 0 5\n",
+                &e);
     REQUIRE(e);
     CHECK(e.line == 9);
     CHECK(e.message.find("vertex 5") != std::string::npos);
@@ -338,7 +365,8 @@ TEST_CASE("NPY output: version 1.0 header, <f4, C order", "[pointset][npy]") {
         REQUIRE(bytes.substr(0, 6) == "\x93NUMPY");
         REQUIRE(bytes[6] == 1);
         REQUIRE(bytes[7] == 0);
-        size_t len = static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
+        size_t len =
+            static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
         REQUIRE((10 + len) % 64 == 0);
         header = bytes.substr(10, len);
         REQUIRE(header.back() == '\n');

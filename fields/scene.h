@@ -1,0 +1,69 @@
+// A scene's wind description as loaded from TOML: settings, the windicator and gust rigs,
+// and the [[field]] entries. The solver's sections ([[cloth]], [[hair]], [[collider]]) are
+// described in solver/scene.h and parsed by the solver's loader through the same TOML file.
+#pragma once
+
+#include "fields/keyframes.h"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace gale::fields {
+
+// An error in a scene file, at file:line:col (1-based; 0 when unknown).
+struct SceneError {
+    std::string file;
+    int line = 0;
+    int col = 0;
+    std::string message; // what is wrong and what to do
+    std::string render() const; // "file:line:col: error: message"
+};
+
+struct SceneSettings {
+    double fps = 24.0;
+    int frameStart = 1;
+    int frameEnd = 48;
+    int substeps = 4; // minimum per frame
+    std::vector<double> gravity{0.0, -9.81, 0.0};
+    double airDensity = 1.225;
+};
+
+// The continuity rig: a direction arrow with an animatable intensity. Expressions see it as
+// uniform `$windDir` (unit FP[3]) and `$windSpeed` (FP[1]).
+struct Windicator {
+    Param direction{std::vector<double>{1.0, 0.0, 0.0}};
+    Param speed{0.0};
+};
+
+// A gust event: strength ramps up over `attack`, holds, decays; the front starts at the
+// origin plane through (0,0,0) normal to the wind direction at `start` and sweeps along the
+// wind at `travelSpeed`, so a point at distance d downwind feels it d/travelSpeed later.
+struct Gust {
+    double start = 0.0;
+    double attack = 0.2;
+    double hold = 0.3;
+    double decay = 0.6;
+    Param strength{0.0}; // m/s added along the windicator direction
+    double travelSpeed = 8.0;
+};
+
+struct FieldEntry {
+    std::string name;
+    std::string exprPath;          // resolved against the scene's folder ("" when inline)
+    std::string source;            // inline expression text (when exprPath is empty)
+    std::map<std::string, Param> params; // overrides of the expression's parameters
+    Param scale{1.0};
+};
+
+struct Scene {
+    std::string path;    // the scene file
+    std::string baseDir; // its folder: relative paths resolve here
+    SceneSettings settings;
+    std::optional<Windicator> windicator;
+    std::vector<Gust> gusts;
+    std::vector<FieldEntry> fields;
+};
+
+} // namespace gale::fields
