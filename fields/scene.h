@@ -67,3 +67,22 @@ struct Scene {
 };
 
 } // namespace gale::fields
+
+namespace gale::fields {
+
+struct SceneLoadOptions {
+    // `--set KEY=VALUE` overrides by dotted path (`windicator.speed=12`, `field.main.params.swirl=0.3`,
+    // `scene.fps=30`); an unknown path is an error.
+    std::vector<std::string> sets;
+    // Top-level sections another layer parses (the solver passes "cloth", "hair", "collider");
+    // any other unknown key is an error.
+    std::vector<std::string> foreignSections{"cloth", "hair", "collider"};
+};
+
+// Reads and validates the wind part of a scene file. Errors carry file:line:col (toml++
+// source regions); every problem found is reported, not just the first. Returns false when
+// there were errors.
+bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& errors,
+               const SceneLoadOptions& options = {});
+
+} // namespace gale::fields

@@ -660,6 +660,12 @@ Value Compiler::callBuiltin(const Expr* e, const FunctionInfo& fn, int32_t index
         result.kind = site.resultType.kind;
         result.width = site.resultType.width;
     }
+    for (const FunctionInfo::Implicit& im : fn.implicitArgs) {
+        const HostVariable* hv = findHost(std::string(im.variable));
+        Value v = hv ? hostInput(*hv) : constant(im.fallback);
+        result.lifetime = combine(result.lifetime, v.type.lifetime);
+        args.push_back(v);
+    }
     Instr in;
     in.op = Op::Call;
     in.imm = index;

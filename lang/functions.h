@@ -61,6 +61,14 @@ struct FunctionInfo {
     // Optional extra validation after the signature matched; reports to site.sink and
     // returns false on error; may set site.resultType.
     bool (*validate)(CallSite& site) = nullptr;
+    // Host variables the compiler appends as extra arguments after the declared ones (e.g.
+    // gust(P) also reads $t). A variable the host does not define is passed as the constant
+    // `fallback`.
+    struct Implicit {
+        std::string_view variable;
+        double fallback = 0.0;
+    };
+    std::vector<Implicit> implicitArgs;
     // Filled by the table from `signature` once.
     ParsedSignature parsed;
 };

@@ -16,6 +16,9 @@ struct Builtin {
     lang::FunctionInfo info;
     Kernel<float> kernelF = nullptr;
     Kernel<double> kernelD = nullptr;
+    // Data the kernels receive as KernelFrame::user (kept alive by the table). Must be safe to
+    // read from many threads at once.
+    std::shared_ptr<const void> data;
 };
 
 // A scalar function F<T>::apply lifted to a Builtin whose kernels broadcast over FP[n].

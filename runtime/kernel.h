@@ -40,6 +40,8 @@ struct KernelFrame {
     int maskStride = 0;
     // printf output of this block, appended in lane order; the evaluator emits blocks in order.
     std::string* messages = nullptr;
+    // The built-in's own data (Builtin::data): e.g. a scene's gust rig or a turbulence cache.
+    const void* user = nullptr;
 
     T* outComp(int k) const { return out + k * outCompStride; }
     bool active(int i) const { return mask == nullptr || mask[i * maskStride] != T(0); }

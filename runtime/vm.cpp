@@ -246,6 +246,7 @@ template <class T> void execCall(const Instr& in, ExecContext<T>& c) {
         f.maskStride = m.laneStride;
     }
     f.messages = c.messages;
+    f.user = fn.data.get();
     Kernel<T> k;
     if constexpr (std::is_same_v<T, float>) k = fn.kernelF;
     else k = fn.kernelD;
