@@ -72,6 +72,7 @@ struct BenchOptions {
 
 struct BuiltinsOptions {
     bool json = false;
+    bool markdown = false; // the reference page docs/builtins.md is this output
 };
 
 int runCheck(const CheckOptions& options);
