@@ -2,6 +2,7 @@
 // per component over FP[n]. The vector and selection families are registered from here too.
 #include "runtime/builtins.h"
 #include "runtime/builtins_detail.h"
+#include "runtime/fastmath.h"
 
 #include <cmath>
 
@@ -38,6 +39,31 @@ template <class T> struct Asinh { static T apply(T x) { return std::asinh(x); } 
 template <class T> struct Acosh { static T apply(T x) { return std::acosh(x); } };
 template <class T> struct Atanh { static T apply(T x) { return std::atanh(x); } };
 template <class T> struct Trunc { static T apply(T x) { return std::trunc(x); } };
+
+// Float lanes of sin, cos, exp and log go through the vectorised fastmath arrays (uniform
+// operands too, so a value gives the same bits whichever way it is computed); double lanes use
+// libm, as SeExpr2 does.
+template <template <class> class F, void (*Array)(const float*, float*, int)>
+struct FastMap {
+    template <class T>
+    static void run(const KernelFrame<T>& f) {
+        if constexpr (std::is_same_v<T, float>) {
+            const Operand<float>& a = f.args[0];
+            for (int k = 0; k < f.outWidth; ++k) {
+                float* __restrict o = f.outComp(k);
+                if (a.uniform()) {
+                    float v;
+                    Array(a.comp(k), &v, 1);
+                    for (int i = 0; i < f.n; ++i) o[i] = v;
+                } else {
+                    Array(a.comp(k), o, f.n);
+                }
+            }
+        } else {
+            mapKernel1<F, T>(f);
+        }
+    }
+};
 
 // ---- Angles ----------------------------------------------------------------------------------
 template <class T> struct Deg { static T apply(T a) { return a * T(kRadToDeg); } };
@@ -168,15 +194,15 @@ void addMathBuiltins(FunctionTable& t) {
     t.add(mapBuiltin1<Atan>("atan", "FP[n] atan(FP[n] x)", "arc tangent, in radians"));
     t.add(mapBuiltin2<Atan2>("atan2", "FP[n] atan2(FP[n] y, FP[n] x)", "arc tangent of y/x in [-PI, PI]"));
     t.add(mapBuiltin1<Ceil>("ceil", "FP[n] ceil(FP[n] x)", "smallest integer not below x"));
-    t.add(mapBuiltin1<Cos>("cos", "FP[n] cos(FP[n] angle)", "cosine (radians)"));
+    t.add(kernelBuiltin<FastMap<Cos, &fastmath::cosArray>>("cos", "FP[n] cos(FP[n] angle)", "cosine (radians)"));
     t.add(mapBuiltin1<Cosh>("cosh", "FP[n] cosh(FP[n] x)", "hyperbolic cosine"));
-    t.add(mapBuiltin1<Exp>("exp", "FP[n] exp(FP[n] x)", "E raised to the power x"));
+    t.add(kernelBuiltin<FastMap<Exp, &fastmath::expArray>>("exp", "FP[n] exp(FP[n] x)", "E raised to the power x"));
     t.add(mapBuiltin1<Floor>("floor", "FP[n] floor(FP[n] x)", "largest integer not above x"));
     t.add(mapBuiltin2<Fmod>("fmod", "FP[n] fmod(FP[n] x, FP[n] y)", "C's remainder of x/y (sign of x; % is floored)"));
-    t.add(mapBuiltin1<Log>("log", "FP[n] log(FP[n] x)", "natural logarithm"));
+    t.add(kernelBuiltin<FastMap<Log, &fastmath::logArray>>("log", "FP[n] log(FP[n] x)", "natural logarithm"));
     t.add(mapBuiltin1<Log10>("log10", "FP[n] log10(FP[n] x)", "base-10 logarithm"));
     t.add(mapBuiltin2<Pow>("pow", "FP[n] pow(FP[n] x, FP[n] y)", "x to the power y (also x^y)"));
-    t.add(mapBuiltin1<Sin>("sin", "FP[n] sin(FP[n] angle)", "sine (radians)"));
+    t.add(kernelBuiltin<FastMap<Sin, &fastmath::sinArray>>("sin", "FP[n] sin(FP[n] angle)", "sine (radians)"));
     t.add(mapBuiltin1<Sinh>("sinh", "FP[n] sinh(FP[n] x)", "hyperbolic sine"));
     t.add(mapBuiltin1<Sqrt>("sqrt", "FP[n] sqrt(FP[n] x)", "square root"));
     t.add(mapBuiltin1<Tan>("tan", "FP[n] tan(FP[n] angle)", "tangent (radians)"));

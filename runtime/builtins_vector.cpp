@@ -28,6 +28,17 @@ struct V3Reader {
     }
 };
 
+// The same with the lane stride known at compile time (see withStrides): the hot kernels use
+// it so that their loops vectorise.
+template <class T, int S>
+struct V3ReaderS {
+    const T* __restrict c0;
+    const T* __restrict c1;
+    const T* __restrict c2;
+    explicit V3ReaderS(const Operand<T>& o) : c0(o.comp(0)), c1(o.comp(1)), c2(o.comp(2)) {}
+    V3<T> operator[](int i) const { return {c0[i * S], c1[i * S], c2[i * S]}; }
+};
+
 template <class T>
 struct V3Writer {
     T* c0;
@@ -73,33 +84,62 @@ template <class T> V3<T> rotateBy(const V3<T>& p, const V3<T>& a, T angle) {
 
 struct LengthK {
     template <class T> static void run(const KernelFrame<T>& f) {
-        const V3Reader<T> v(f.args[0]);
-        T* __restrict o = f.outComp(0);
-        for (int i = 0; i < f.n; ++i) o[i] = length(v[i]);
+        withStrides(f.args[0].laneStride, [&](auto s) {
+            const V3ReaderS<T, decltype(s)::value> v(f.args[0]);
+            T* __restrict o = f.outComp(0);
+            for (int i = 0; i < f.n; ++i) o[i] = length(v[i]);
+        });
     }
 };
 
 struct DotK {
     template <class T> static void run(const KernelFrame<T>& f) {
-        const V3Reader<T> a(f.args[0]), b(f.args[1]);
-        T* __restrict o = f.outComp(0);
-        for (int i = 0; i < f.n; ++i) o[i] = dot(a[i], b[i]);
+        withStrides(f.args[0].laneStride, f.args[1].laneStride, [&](auto sa, auto sb) {
+            const V3ReaderS<T, decltype(sa)::value> a(f.args[0]);
+            const V3ReaderS<T, decltype(sb)::value> b(f.args[1]);
+            T* __restrict o = f.outComp(0);
+            for (int i = 0; i < f.n; ++i) o[i] = dot(a[i], b[i]);
+        });
     }
 };
 
 struct CrossK {
     template <class T> static void run(const KernelFrame<T>& f) {
-        const V3Reader<T> a(f.args[0]), b(f.args[1]);
-        const V3Writer<T> o(f);
-        for (int i = 0; i < f.n; ++i) o.set(i, cross(a[i], b[i]));
+        withStrides(f.args[0].laneStride, f.args[1].laneStride, [&](auto sa, auto sb) {
+            constexpr int A = decltype(sa)::value, B = decltype(sb)::value;
+            const T* __restrict ax = f.args[0].comp(0);
+            const T* __restrict ay = f.args[0].comp(1);
+            const T* __restrict az = f.args[0].comp(2);
+            const T* __restrict bx = f.args[1].comp(0);
+            const T* __restrict by = f.args[1].comp(1);
+            const T* __restrict bz = f.args[1].comp(2);
+            T* __restrict o0 = f.outComp(0);
+            T* __restrict o1 = f.outComp(1);
+            T* __restrict o2 = f.outComp(2);
+            for (int i = 0; i < f.n; ++i) {
+                const V3<T> c = cross(V3<T>{ax[i * A], ay[i * A], az[i * A]}, V3<T>{bx[i * B], by[i * B], bz[i * B]});
+                o0[i] = c.x;
+                o1[i] = c.y;
+                o2[i] = c.z;
+            }
+        });
     }
 };
 
 struct NormK {
     template <class T> static void run(const KernelFrame<T>& f) {
-        const V3Reader<T> v(f.args[0]);
-        const V3Writer<T> o(f);
-        for (int i = 0; i < f.n; ++i) o.set(i, norm(v[i]));
+        withStrides(f.args[0].laneStride, [&](auto s) {
+            const V3ReaderS<T, decltype(s)::value> v(f.args[0]);
+            T* __restrict o0 = f.outComp(0);
+            T* __restrict o1 = f.outComp(1);
+            T* __restrict o2 = f.outComp(2);
+            for (int i = 0; i < f.n; ++i) {
+                const V3<T> u = norm(v[i]);
+                o0[i] = u.x;
+                o1[i] = u.y;
+                o2[i] = u.z;
+            }
+        });
     }
 };
 

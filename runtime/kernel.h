@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <type_traits>
 
 namespace gale::runtime {
 
@@ -50,6 +51,29 @@ struct KernelFrame {
 template <class T>
 using Kernel = void (*)(const KernelFrame<T>& f);
 
+// Calls fn with each lane stride (0 or 1) as a compile-time constant, so that a kernel written
+// as `x[i * S]` compiles to a contiguous, vectorisable loop for varying operands and to a
+// broadcast for uniform ones.
+template <class F>
+void withStrides(int s0, F&& fn) {
+    if (s0) fn(std::integral_constant<int, 1>{});
+    else fn(std::integral_constant<int, 0>{});
+}
+template <class F>
+void withStrides(int s0, int s1, F&& fn) {
+    withStrides(s0, [&](auto a) {
+        if (s1) fn(a, std::integral_constant<int, 1>{});
+        else fn(a, std::integral_constant<int, 0>{});
+    });
+}
+template <class F>
+void withStrides(int s0, int s1, int s2, F&& fn) {
+    withStrides(s0, s1, [&](auto a, auto b) {
+        if (s2) fn(a, b, std::integral_constant<int, 1>{});
+        else fn(a, b, std::integral_constant<int, 0>{});
+    });
+}
+
 // ---- Scalar functions lifted to kernels -----------------------------------------------------
 // F<T>::apply(T...) -> T is a plain scalar function. The result width is the broadcast width of
 // the arguments; each component is a plain loop over lanes, specialised for uniform operands so
@@ -93,20 +117,20 @@ void mapKernel2(const KernelFrame<T>& f) {
     }
 }
 
-// Any number of arguments (3 and more): the general strided form.
 template <template <class> class F, class T>
 void mapKernel3(const KernelFrame<T>& f) {
     const Operand<T>& a = f.args[0];
     const Operand<T>& b = f.args[1];
     const Operand<T>& c = f.args[2];
-    for (int k = 0; k < f.outWidth; ++k) {
-        T* __restrict o = f.outComp(k);
-        const T* __restrict x = a.comp(k);
-        const T* __restrict y = b.comp(k);
-        const T* __restrict z = c.comp(k);
-        const int sa = a.laneStride, sb = b.laneStride, sc = c.laneStride;
-        for (int i = 0; i < f.n; ++i) o[i] = F<T>::apply(x[i * sa], y[i * sb], z[i * sc]);
-    }
+    withStrides(a.laneStride, b.laneStride, c.laneStride, [&](auto sa, auto sb, auto sc) {
+        for (int k = 0; k < f.outWidth; ++k) {
+            T* __restrict o = f.outComp(k);
+            const T* __restrict x = a.comp(k);
+            const T* __restrict y = b.comp(k);
+            const T* __restrict z = c.comp(k);
+            for (int i = 0; i < f.n; ++i) o[i] = F<T>::apply(x[i * sa], y[i * sb], z[i * sc]);
+        }
+    });
 }
 
 template <template <class> class F, class T>

@@ -264,8 +264,11 @@ EvalResult evaluate(const Program& program, const EvalRequest& request, const Ev
             for (int k = 0; k < vb.width; ++k) {
                 T* __restrict o = dst + k * L.compStride;
                 const int kk = in.width == 1 ? 0 : k;
-                const double* src = in.data + static_cast<std::ptrdiff_t>(first) * in.pointStride + kk * in.compStride;
-                for (int i = 0; i < n; ++i) o[i] = static_cast<T>(src[i * in.pointStride]);
+                const double* __restrict src = in.data + static_cast<std::ptrdiff_t>(first) * in.pointStride + kk * in.compStride;
+                // The common layouts get loops with a constant stride (vectorised gathers).
+                if (in.pointStride == 1) for (int i = 0; i < n; ++i) o[i] = static_cast<T>(src[i]);
+                else if (in.pointStride == 3) for (int i = 0; i < n; ++i) o[i] = static_cast<T>(src[3 * i]);
+                else for (int i = 0; i < n; ++i) o[i] = static_cast<T>(src[i * in.pointStride]);
             }
         }
         for (int32_t i : program.varyingCode()) execute(bc.code[static_cast<size_t>(i)], ctx);
