@@ -52,7 +52,7 @@ struct EvalOptions {
     double frame = 0.0;
     bool hasFrame = false;
     double fps = 24.0;
-    std::string precision = "float";
+    std::string precision; // "", "float" or "double" ("": float with --points, else double)
     int threads = -1;   // -1: all hardware threads with --points, 1 without
     std::string output; // -o OUT ("-" or empty: stdout)
     std::string format; // csv | ply | ply-ascii | json | npy | obj (empty: from -o, else csv)
@@ -75,14 +75,48 @@ struct BuiltinsOptions {
     bool markdown = false; // the reference page docs/builtins.md is this output
 };
 
+// `gale sample` (cli/sample_command.cpp).
+struct SampleOptions {
+    SourceOptions source;   // FILE.se | -e EXPR | SCENE.toml, --set
+    std::string bounds;     // x0,y0,z0,x1,y1,z1
+    std::string res;        // N (cubic voxels, N along the longest side) or NX,NY,NZ
+    double voxel = 0.0;     // cubic voxel size (instead of --res)
+    double time = 0.0;      // seconds
+    std::string frames;     // A:B (t = frame / fps), OUT has '#'
+    double fps = 0.0;       // 0: the scene's, else 24
+    int threads = 0;        // 0: all hardware threads
+    std::string output;     // -o OUT ("-" or empty: stdout)
+    std::string format;     // vdb | npy | csv (empty: from -o, else csv)
+};
+
+// `gale viz` (cli/viz_command.cpp).
+struct VizOptions {
+    SourceOptions source;
+    std::string plane = "z=0";       // x=C | y=C | z=C
+    std::string bounds;              // u0,v0,u1,v1 in the plane's axes
+    double time = 0.0;
+    double fps = 0.0;                // 0: the scene's, else 24
+    std::string size = "1024x1024";  // WxH pixels
+    std::string output;              // -o slice.(png|svg)
+    std::string style = "arrows";    // arrows | streamlines | none
+    double speedMax = 0.0;           // colour scale top in m/s (0: from the slice)
+    double arrowSpacing = 0.0;       // pixels between arrows (0: about 22 across)
+    int threads = 0;
+};
+
 int runCheck(const CheckOptions& options);
 int runEval(const EvalOptions& options);
 int runBench(const BenchOptions& options);
 int runBuiltins(const BuiltinsOptions& options);
 
+int runSample(const SampleOptions& options);
+int runViz(const VizOptions& options);
+
 Command addCheckCommand(CLI::App& app);
 Command addEvalCommand(CLI::App& app);
 Command addBenchCommand(CLI::App& app);
 Command addBuiltinsCommand(CLI::App& app);
+Command addSampleCommand(CLI::App& app);
+Command addVizCommand(CLI::App& app);
 
 } // namespace gale::cli

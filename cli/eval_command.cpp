@@ -151,7 +151,9 @@ int runEval(const EvalOptions& o) {
     bindings.fillRequest(request);
     request.threads = o.threads >= 0 ? o.threads : havePoints ? 0 : 1;
     request.checked = o.checked;
-    const bool asFloat = o.precision != "double";
+    // One value (no --points) is evaluated in double unless asked otherwise: speed is moot
+    // there, and double gives SeExpr2's numbers exactly. Point sets default to float.
+    const bool asFloat = o.precision.empty() ? havePoints : o.precision == "float";
     const int width = program->resultIsString() ? 1 : program->resultWidth();
     std::vector<double> values;
     std::vector<std::string> strings;
@@ -243,9 +245,10 @@ Command addEvalCommand(CLI::App& app) {
            "$frame (default: --time * --fps)")
         ->type_name("F");
     sub->add_option("--fps", o->fps, "$fps, frames per second")->capture_default_str();
-    sub->add_option("--precision", o->precision, "Evaluate in float or double")
-        ->check(CLI::IsMember({"float", "double"}))
-        ->capture_default_str();
+    sub->add_option("--precision", o->precision,
+                    "Evaluate in float or double (default: float with --points, double for a "
+                    "single value)")
+        ->check(CLI::IsMember({"float", "double"}));
     sub->add_option("--threads", o->threads,
                     "Threads; 0 = all hardware threads (default: all with --points, else 1). "
                     "Results do not depend on it")

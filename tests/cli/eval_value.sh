@@ -11,8 +11,11 @@ expect_eq "$OUT" "7" "integer prints without .0"
 
 run "$GALE" eval -e '1/3' --precision double
 expect_eq "$OUT" "0.3333333333333333" "1/3 in double round-trips"
-run "$GALE" eval -e '1/3'
+run "$GALE" eval -e '1/3' --precision float
 expect_eq "$OUT" "0.33333334" "1/3 in float: the shortest text of the float"
+# A single value defaults to double (SeExpr2's numbers): sin(1) to 17 significant digits.
+run "$GALE" eval -e 'sin(1)'
+expect_eq "$OUT" "$(printf '%s' 0.8414709848078965)" "a single value is evaluated in double by default"
 
 run "$GALE" eval -e '0.1' --precision double
 expect_eq "$OUT" "0.1" "0.1"
