@@ -1,6 +1,9 @@
 // Helpers shared by the subcommands: sources, --set values, host bindings, compiling with
 // diagnostics on stderr, number output and atomic text files.
 #include "cli/common.h"
+#include "fields/atomic_file.h"
+
+#include "fields/expression_field.h"
 
 #include <CLI/CLI.hpp>
 
@@ -245,20 +248,27 @@ void Bindings::fillRequest(runtime::EvalRequest& request) const {
 
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth) {
+                 int wantWidth, const lang::SourceFile* shown) {
     runtime::CompileSettings settings;
     settings.variables = variables;
     settings.wantWidth = wantWidth;
+    settings.functions = fields::fieldFunctions();
     lang::DiagnosticSink sink;
     std::shared_ptr<const runtime::Program> program =
         runtime::Program::compile(source, settings, sink);
     if (!sink.diagnostics().empty()) {
         lang::RenderOptions options;
         options.color = useColor();
-        std::cerr << lang::renderDiagnostics(source, sink, options) << std::flush;
+        std::cerr << lang::renderDiagnostics(shown ? *shown : source, sink, options) << std::flush;
     }
     if (sink.hasErrors()) return nullptr;
     return program;
+}
+
+lang::SourceFile bindParameters(const lang::SourceFile& source, Bindings& bindings) {
+    const std::vector<fields::ParameterDecl> params = fields::findParameters(source);
+    for (const fields::ParameterDecl& p : params) bindings.setUniform(p.name, p.defaultValue);
+    return fields::withoutParameters(source, params);
 }
 
 int loadPoints(const std::string& path, fields::PointSet& points) {
@@ -276,29 +286,9 @@ std::string formatValue(double v, bool asFloat) {
 }
 
 int writeTextFileAtomic(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-    errno = 0;
-    bool ok = false;
-    int err = 0;
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (f) {
-            f.write(text.data(), static_cast<std::streamsize>(text.size()));
-            f.flush();
-            err = errno;
-            f.close();
-            ok = !f.fail();
-        } else {
-            err = errno;
-        }
-    }
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-        err = errno;
-        ok = false;
-    }
-    if (!ok) {
-        std::remove(tmp.c_str());
-        printError("cannot write '" + path + "': " + (err ? std::strerror(err) : "write failed"));
+    fields::IoError e = fields::writeBytesAtomic(path, text);
+    if (e) {
+        printError(e.render());
         return kExitIo;
     }
     return kExitOk;

@@ -75,11 +75,17 @@ private:
     std::deque<std::vector<double>> mStorage;
 };
 
-// Compiles `source`, printing every diagnostic (errors and warnings) to stderr. Null on
-// errors.
+// Compiles `source` against the field layer's built-ins (the standard ones plus gust, fftturb,
+// ...), printing every diagnostic (errors and warnings) to stderr, rendered against `shown`
+// when given (the text before parameters were blanked). Null on errors.
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth);
+                 int wantWidth, const lang::SourceFile* shown = nullptr);
+
+// The parameter idiom (`$speed = 5;  # 0, 40`): binds each declared parameter as a uniform of
+// its default value (a later --set of the same name replaces it) and returns the source with
+// the declarations blanked, so the bindings win.
+lang::SourceFile bindParameters(const lang::SourceFile& source, Bindings& bindings);
 
 // Reads a point file, printing IoError::render() on failure; returns an exit code.
 int loadPoints(const std::string& path, fields::PointSet& points);

@@ -1,7 +1,11 @@
 // `gale eval`: compile an expression and evaluate it once (printing the value on one line) or
-// at every point of a point file (writing the points with the result columns added).
+// at every point of a point file (writing the points with the result columns added). A
+// SCENE.toml in place of FILE.se samples the scene's summed wind the same way.
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/field_input.h"
+#include "fields/expression_field.h"
+#include "fields/scene.h"
 
 #include <CLI/CLI.hpp>
 
@@ -83,9 +87,151 @@ int reportNonFinite(const lang::SourceFile& source, const runtime::EvalResult& r
     return kExitNumeric;
 }
 
+// Prints one value line, or writes it to -o.
+int writeValueLine(const EvalOptions& o, std::string line) {
+    line += '\n';
+    if (!o.output.empty() && o.output != "-") return writeTextFileAtomic(o.output, line);
+    std::cout << line << std::flush;
+    return std::cout ? kExitOk : kExitIo;
+}
+
+// Writes the points with the result columns (point-major `values`, `width` per point) added,
+// replacing columns of the same names.
+int writePointResults(const EvalOptions& o, fields::PointSet& points,
+                      const std::vector<double>& values, int width, bool asFloat,
+                      fields::PointFormat format) {
+    std::vector<int> added;
+    for (const std::string& name : resultColumns(width)) added.push_back(points.addColumn(name));
+    if (points.float32.size() < points.names.size())
+        points.float32.resize(points.names.size(), false);
+    const size_t n = points.size();
+    for (int k = 0; k < width; ++k) {
+        std::vector<double>& col =
+            points.columns[static_cast<size_t>(added[static_cast<size_t>(k)])];
+        for (size_t i = 0; i < n; ++i)
+            col[i] = values[i * static_cast<size_t>(width) + static_cast<size_t>(k)];
+        points.float32[static_cast<size_t>(added[static_cast<size_t>(k)])] = asFloat;
+    }
+    const std::vector<int> npyColumns =
+        format == fields::PointFormat::Npy ? added : std::vector<int>{};
+    if (o.output.empty() || o.output == "-") {
+        fields::IoError e = fields::writePoints(std::cout, points, format, npyColumns);
+        std::cout.flush();
+        if (e || !std::cout) {
+            printError("cannot write to stdout" + (e ? ": " + e.message : std::string()));
+            return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
+        }
+        return kExitOk;
+    }
+    fields::IoError e = fields::writePointsFile(o.output, points, format, npyColumns);
+    if (e) {
+        std::cerr << e.render() << '\n';
+        return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
+    }
+    return kExitOk;
+}
+
+// Reads --points and checks for x, y, z; returns an exit code.
+int loadEvalPoints(const std::string& path, fields::PointSet& points) {
+    if (int rc = loadPoints(path, points)) return rc;
+    if (points.find("x") < 0 || points.find("y") < 0 || points.find("z") < 0) {
+        std::string have;
+        for (const std::string& n : points.names) have += (have.empty() ? "" : ", ") + n;
+        std::cerr << (path == "-" ? std::string("<stdin>") : path)
+                  << ": error: the points need x, y and z columns (found: "
+                  << (have.empty() ? std::string("none") : have) << ")\n";
+        return kExitInput;
+    }
+    return kExitOk;
+}
+
+// Prints every scene error; returns 3 when a file could not be read, else 1.
+int reportSceneErrors(const std::vector<fields::SceneError>& errors) {
+    bool io = false;
+    for (const fields::SceneError& e : errors) {
+        std::cerr << e.render() << '\n';
+        io = io || e.io;
+    }
+    std::cerr << std::flush;
+    return io ? kExitIo : kExitInput;
+}
+
+// `gale eval SCENE.toml`: the scene's summed wind at the origin or at every point. --set
+// overrides scene keys by dotted path; --fps defaults to the scene's.
+int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
+                 fields::PointFormat format) {
+    if (o.disasm) {
+        printError("--disasm needs an expression (FILE.se or -e EXPR), not a scene");
+        return kExitUsage;
+    }
+    if (o.source.type == "float") {
+        printError("a scene's wind is a vector: --type float cannot apply to " + o.source.file);
+        return kExitUsage;
+    }
+    fields::Scene scene;
+    std::vector<fields::SceneError> errors;
+    fields::SceneLoadOptions options;
+    options.sets = o.source.sets;
+    if (!fields::loadScene(o.source.file, scene, errors, options))
+        return reportSceneErrors(errors);
+    const bool asFloat = o.precision != "double";
+    std::string report;
+    fields::FieldPtr field = fields::buildSceneField(
+        scene, asFloat ? runtime::Precision::Float : runtime::Precision::Double, report,
+        useColor());
+    if (!report.empty()) std::cerr << report << std::flush;
+    if (!field) return kExitInput;
+
+    fields::PointSet points;
+    if (havePoints) {
+        if (int rc = loadEvalPoints(o.points, points)) return rc;
+    }
+    const double fps = fpsGiven ? o.fps : scene.settings.fps;
+    fields::SampleTime when;
+    when.fps = fps;
+    when.time = o.hasTime ? o.time : o.hasFrame ? o.frame / fps : 0.0;
+    when.threads = o.threads >= 0 ? o.threads : havePoints ? 0 : 1;
+    const size_t n = havePoints ? points.size() : 1;
+    std::vector<double> positions(3 * n, 0.0);
+    if (havePoints) {
+        const int axes[3] = {points.find("x"), points.find("y"), points.find("z")};
+        for (size_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k)
+                positions[3 * i + static_cast<size_t>(k)] =
+                    points.columns[static_cast<size_t>(axes[k])][i];
+    }
+    std::vector<double> velocities(3 * n, 0.0);
+    fields::SampleStatus status = field->sample(positions.data(), n, when, velocities.data());
+    if (!status.ok) {
+        printError("cannot evaluate " + o.source.file + ": " + status.message);
+        return kExitInput;
+    }
+    if (status.nonFinite > 0) {
+        if (o.checked) {
+            printError(std::to_string(status.nonFinite) + " of " + std::to_string(n) +
+                       " point(s) gave a non-finite velocity; nothing was written");
+            return kExitNumeric;
+        }
+        printError("warning: " + status.message);
+    }
+    if (!havePoints) {
+        std::string line;
+        for (int k = 0; k < 3; ++k)
+            line += (k ? " " : "") + formatValue(velocities[static_cast<size_t>(k)], asFloat);
+        return writeValueLine(o, line);
+    }
+    return writePointResults(o, points, velocities, 3, asFloat, format);
+}
+
+int runEvalImpl(const EvalOptions& o, bool fpsGiven);
+
 } // namespace
 
-int runEval(const EvalOptions& o) {
+int runEval(const EvalOptions& o) { return runEvalImpl(o, true); }
+
+namespace {
+
+int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     if (o.source.file == "-" && o.points == "-") {
         printError("the expression and the points cannot both come from stdin");
         return kExitUsage;
@@ -94,8 +240,9 @@ int runEval(const EvalOptions& o) {
         printError("--fps must be a positive number");
         return kExitUsage;
     }
+    const bool scene = o.source.expr.empty() && isSceneFile(o.source.file);
     std::vector<SetValue> sets;
-    if (!parseSets(o.source.sets, sets)) return kExitUsage;
+    if (!scene && !parseSets(o.source.sets, sets)) return kExitUsage;
     const bool havePoints = !o.points.empty();
     fields::PointFormat format = fields::PointFormat::Csv;
     if (havePoints) {
@@ -110,6 +257,7 @@ int runEval(const EvalOptions& o) {
         printError("--format needs --points (without points the value is printed as text)");
         return kExitUsage;
     }
+    if (scene) return runEvalScene(o, fpsGiven, havePoints, format);
     lang::SourceFile source;
     if (int rc = loadSource(o.source.file, o.source.expr, source)) return rc;
 
@@ -119,22 +267,16 @@ int runEval(const EvalOptions& o) {
 
     fields::PointSet points;
     if (havePoints) {
-        if (int rc = loadPoints(o.points, points)) return rc;
-        if (points.find("x") < 0 || points.find("y") < 0 || points.find("z") < 0) {
-            std::string have;
-            for (const std::string& n : points.names) have += (have.empty() ? "" : ", ") + n;
-            std::cerr << (o.points == "-" ? std::string("<stdin>") : o.points)
-                      << ": error: the points need x, y and z columns (found: "
-                      << (have.empty() ? std::string("none") : have) << ")\n";
-            return kExitInput;
-        }
+        if (int rc = loadEvalPoints(o.points, points)) return rc;
     }
     Bindings bindings(t, frame, o.fps);
     if (havePoints) bindings.addPoints(points);
+    // Declared parameters (`$speed = 5;  # 0, 40`) become uniforms that --set overrides.
+    const lang::SourceFile compiled = bindParameters(source, bindings);
     bindings.addSets(sets);
 
-    std::shared_ptr<const runtime::Program> program =
-        compileAndReport(source, bindings.variables(), wantWidthFor(o.source.type));
+    std::shared_ptr<const runtime::Program> program = compileAndReport(
+        compiled, bindings.variables(), wantWidthFor(o.source.type), &source);
     if (!program) return kExitInput;
     if (o.disasm) {
         std::cout << program->disassemble() << std::flush;
@@ -167,7 +309,6 @@ int runEval(const EvalOptions& o) {
     }
     if (o.checked && r.nonFinite > 0) return reportNonFinite(source, r, request.count);
 
-    const bool toStdout = o.output.empty() || o.output == "-";
     if (!havePoints) {
         std::string line;
         if (program->resultIsString()) {
@@ -178,43 +319,12 @@ int runEval(const EvalOptions& o) {
                 line += formatValue(values[static_cast<size_t>(k)], asFloat);
             }
         }
-        line += '\n';
-        if (!toStdout) return writeTextFileAtomic(o.output, line);
-        std::cout << line << std::flush;
-        return std::cout ? kExitOk : kExitIo;
+        return writeValueLine(o, line);
     }
-
-    // The points with the result columns added (replacing columns of the same names).
-    std::vector<int> added;
-    for (const std::string& name : resultColumns(width)) added.push_back(points.addColumn(name));
-    if (points.float32.size() < points.names.size())
-        points.float32.resize(points.names.size(), false);
-    const size_t n = points.size();
-    for (int k = 0; k < width; ++k) {
-        std::vector<double>& col =
-            points.columns[static_cast<size_t>(added[static_cast<size_t>(k)])];
-        for (size_t i = 0; i < n; ++i)
-            col[i] = values[i * static_cast<size_t>(width) + static_cast<size_t>(k)];
-        points.float32[static_cast<size_t>(added[static_cast<size_t>(k)])] = asFloat;
-    }
-    const std::vector<int> npyColumns =
-        format == fields::PointFormat::Npy ? added : std::vector<int>{};
-    if (toStdout) {
-        fields::IoError e = fields::writePoints(std::cout, points, format, npyColumns);
-        std::cout.flush();
-        if (e || !std::cout) {
-            printError("cannot write to stdout" + (e ? ": " + e.message : std::string()));
-            return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
-        }
-        return kExitOk;
-    }
-    fields::IoError e = fields::writePointsFile(o.output, points, format, npyColumns);
-    if (e) {
-        std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
-    }
-    return kExitOk;
+    return writePointResults(o, points, values, width, asFloat, format);
 }
+
+} // namespace
 
 Command addEvalCommand(CLI::App& app) {
     auto o = std::make_shared<EvalOptions>();
@@ -244,7 +354,9 @@ Command addEvalCommand(CLI::App& app) {
            },
            "$frame (default: --time * --fps)")
         ->type_name("F");
-    sub->add_option("--fps", o->fps, "$fps, frames per second")->capture_default_str();
+    CLI::Option* fps = sub->add_option("--fps", o->fps,
+                                       "$fps, frames per second (a scene's own fps by default)")
+                           ->capture_default_str();
     sub->add_option("--precision", o->precision,
                     "Evaluate in float or double (default: float with --points, double for a "
                     "single value)")
@@ -270,8 +382,11 @@ Command addEvalCommand(CLI::App& app) {
                   "Check every result for NaN/infinity: report the operation that produced the "
                   "first one and exit 4 without writing output");
     sub->footer("Standard variables: $P (position, varying; (0,0,0) without --points), $t,\n"
-                "$frame, $fps (uniform), $id (point index, varying).");
-    return {sub, [o] { return runEval(*o); }};
+                "$frame, $fps (uniform), $id (point index, varying).\n"
+                "A SCENE.toml in place of FILE samples the scene's summed wind (vx vy vz);\n"
+                "--set then overrides scene keys by dotted path (windicator.speed=12,\n"
+                "field.NAME.params.PARAM=3, scene.fps=30).");
+    return {sub, [o, fps] { return runEvalImpl(*o, fps->count() > 0); }};
 }
 
 } // namespace gale::cli

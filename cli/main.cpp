@@ -44,6 +44,8 @@ int main(int argc, char** argv) {
         addEvalCommand(app),
         addBenchCommand(app),
         addBuiltinsCommand(app),
+        addSampleCommand(app),
+        addVizCommand(app),
     };
 
     wrapAllHelp(app);

@@ -10,6 +10,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,16 +24,35 @@ struct ParameterDecl {
     bool hasRange = false;
     double min = 0.0, max = 0.0;
     int line = 0; // 1-based source line of the declaration
+    lang::Span span;  // the statement, `$` to `;`
+    std::string doc;  // the rest of the comment after the range (or the whole comment)
 };
 
-// Scans a source for parameter declarations (the SeExpr editors' slider idiom).
+// Scans a source for parameter declarations (the SeExpr editors' slider idiom). Only the first
+// declaration of a name counts; the host's own variables ($P, $t, $frame, $fps, $id, $windDir,
+// $windSpeed) are never parameters.
 std::vector<ParameterDecl> findParameters(const lang::SourceFile& source);
+
+// The source with every declaration statement blanked to spaces (newlines kept, so every other
+// byte keeps its line and column): the parameters then come from host bindings.
+lang::SourceFile withoutParameters(const lang::SourceFile& source,
+                                   const std::vector<ParameterDecl>& params);
+
+// Host variables an ExpressionField binds besides the parameters: the standard ones, plus
+// $windDir (FP[3]) and $windSpeed when `scene` has a [windicator].
+std::vector<lang::HostVariable> fieldVariables(const Scene* scene);
 
 struct ExpressionFieldOptions {
     std::map<std::string, Param> params; // overrides by parameter name (may be keyframed)
     runtime::Precision precision = runtime::Precision::Float;
-    const Scene* scene = nullptr;        // windicator/gust rigs: $windDir, $windSpeed, gust(P)
+    // Windicator and gust rigs ($windDir, $windSpeed, gust(P)); read during compile() only (the
+    // field copies what it needs), so the scene need not outlive the field.
+    const Scene* scene = nullptr;
+    // More host variables: given values through sampleWith(), zero when sample() is used.
     std::vector<lang::HostVariable> extraVariables;
+    // The built-ins; null: sceneFunctions(*scene) with a scene, else fieldFunctions().
+    std::shared_ptr<const runtime::FunctionTable> functions;
+    std::string name; // for describe() (default: the source's name)
 };
 
 class ExpressionField : public Field {
@@ -45,15 +65,23 @@ public:
 
     SampleStatus sample(const double* positions, size_t count, const SampleTime& when,
                         double* velocities) const override;
+    // The same with values for extraVariables (uniforms, or varyings of `count` points).
+    SampleStatus sampleWith(const double* positions, size_t count, const SampleTime& when,
+                            double* velocities, const std::vector<runtime::UniformValue>& uniforms,
+                            const std::vector<runtime::VaryingInput>& varyings) const;
     std::string describe() const override;
 
     const runtime::Program& program() const { return *mProgram; }
     const std::vector<ParameterDecl>& parameters() const { return mParameters; }
+    // The value each parameter takes at time t (override or default), by declaration order.
+    std::vector<std::vector<double>> parameterValues(double t) const;
 
 private:
     std::shared_ptr<const runtime::Program> mProgram;
     std::vector<ParameterDecl> mParameters;
-    ExpressionFieldOptions mOptions;
+    std::vector<Param> mValues; // per parameter: the override, else the default
+    ExpressionFieldOptions mOptions;        // (with `scene` cleared: the field keeps no pointer)
+    std::optional<Windicator> mWindicator; // a copy of the scene's, for $windDir and $windSpeed
     std::string mName;
 };
 
@@ -63,6 +91,12 @@ std::shared_ptr<const runtime::FunctionTable> fieldFunctions();
 // Registration of the field layer's built-ins (each defined in its own file).
 void addGustBuiltins(runtime::FunctionTable& t);       // rigs.cpp: gust(P)
 void addTurbulenceBuiltins(runtime::FunctionTable& t); // fftturb.cpp: fftturb, fftturb4
+
+// The expression of a [[field]] entry (its file, preset or inline source) as a SourceFile.
+// Inline text held verbatim in the scene is placed at its line and column in a file named after
+// the scene, so diagnostics point into the scene. False with `error` when a file is unreadable.
+bool fieldSource(const Scene& scene, const FieldEntry& entry, lang::SourceFile& out,
+                 std::string& error);
 
 // The summed, compiled wind of a scene: every [[field]] with its params and scale. Diagnostics
 // of expression files are rendered (file:line:col + caret) into `report`. Null on errors.

@@ -2,6 +2,8 @@
 // sample a batch of points at a time, thread-safe, with a status instead of exceptions.
 #pragma once
 
+#include "fields/keyframes.h"
+
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -72,5 +74,35 @@ public:
 private:
     std::vector<Term> mTerms;
 };
+
+// A field times a (possibly keyframed) scalar: `scale` of a [[field]] that is animated.
+class ScaledField : public Field {
+public:
+    ScaledField(FieldPtr field, Param scale) : mField(std::move(field)), mScale(std::move(scale)) {}
+    SampleStatus sample(const double* positions, size_t count, const SampleTime& when,
+                        double* velocities) const override;
+    std::string describe() const override;
+
+private:
+    FieldPtr mField;
+    Param mScale;
+};
+
+// A field multiplied component by component by a mask field (a scalar mask is a field whose
+// three components are equal: an expression giving FP[1] promoted to FP[3]).
+class MaskedField : public Field {
+public:
+    MaskedField(FieldPtr field, FieldPtr mask) : mField(std::move(field)), mMask(std::move(mask)) {}
+    SampleStatus sample(const double* positions, size_t count, const SampleTime& when,
+                        double* velocities) const override;
+    std::string describe() const override;
+
+private:
+    FieldPtr mField;
+    FieldPtr mMask;
+};
+
+// Replaces non-finite components by zero; returns how many points had one.
+size_t zeroNonFinite(double* velocities, size_t count);
 
 } // namespace gale::fields

@@ -24,7 +24,9 @@ public:
     // Value at time t: before the first key the first value, after the last the last value;
     // linear / smooth (Hermite with zero tangents, 3s^2-2s^3) / step (hold the left key).
     std::vector<double> at(double t) const;
-    double scalarAt(double t) const { return at(t)[0]; }
+    // The same without allocating: writes width() values to `out`.
+    void evaluate(double t, double* out) const;
+    double scalarAt(double t) const; // component 0 of at(t)
 
     const std::vector<double>& times() const { return mTimes; }
     const std::vector<std::vector<double>>& values() const { return mValues; }

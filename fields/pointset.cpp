@@ -1,6 +1,8 @@
 // Point sets: CSV and OBJ readers, CSV/JSON/NPY/OBJ writers, the atomic file writer, number
 // formatting and the host variables a point set provides. PLY lives in pointset_ply.cpp.
 #include "fields/pointset.h"
+
+#include "fields/atomic_file.h"
 #include "fields/pointset_detail.h"
 
 #include <tiny_obj_loader.h>
@@ -480,34 +482,18 @@ IoError writePoints(std::ostream& out, const PointSet& points, PointFormat forma
 
 IoError writePointsFile(const std::string& path, const PointSet& points, PointFormat format,
                         const std::vector<int>& npyColumns) {
-    std::string tmp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-    {
+    return writeFileAtomic(path, [&](const std::string& tmp) -> IoError {
         errno = 0;
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) return ioError(path, "cannot write: " + errnoText(errno));
+        if (!f) return ioErrorAt(path, "cannot write", errno);
         IoError e = writePoints(f, points, format, npyColumns);
-        int err = errno;
-        if (!e) {
-            f.flush();
-            err = errno;
-            f.close();
-            if (f.fail()) e = ioError(path, "cannot write: " + errnoText(err ? err : errno));
-        }
-        if (e) {
-            f.close();
-            std::remove(tmp.c_str());
-            e.file = path;
-            if (e.kind == IoError::Io && e.message.rfind("cannot write", 0) != 0)
-                e.message = "cannot write: " + errnoText(err);
-            return e;
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        int err = errno;
-        std::remove(tmp.c_str());
-        return ioError(path, "cannot write: " + errnoText(err));
-    }
-    return {};
+        if (e) return e;
+        f.flush();
+        const int err = errno;
+        f.close();
+        if (f.fail()) return ioErrorAt(path, "cannot write", err);
+        return {};
+    });
 }
 
 // ---- host variables ----

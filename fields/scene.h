@@ -18,7 +18,12 @@ struct SceneError {
     int line = 0;
     int col = 0;
     std::string message; // what is wrong and what to do
-    std::string render() const; // "file:line:col: error: message"
+    std::vector<std::string> notes; // extra lines ("did you mean", the declared parameters)
+    std::string sourceLine;         // the offending line of the file, when known
+    bool io = false;                // a file could not be read (the CLI exits 3, not 1)
+    // "file:line:col: error: message" (without :line:col when line is 0), then the source line
+    // with a caret under the column, then "note: ..." lines.
+    std::string render() const;
 };
 
 struct SceneSettings {
@@ -41,6 +46,7 @@ struct Windicator {
 // origin plane through (0,0,0) normal to the wind direction at `start` and sweeps along the
 // wind at `travelSpeed`, so a point at distance d downwind feels it d/travelSpeed later.
 struct Gust {
+    std::string name;  // optional; `--set gust.NAME.strength=...` (or gust.INDEX, from 0)
     double start = 0.0;
     double attack = 0.2;
     double hold = 0.3;
@@ -50,11 +56,17 @@ struct Gust {
 };
 
 struct FieldEntry {
-    std::string name;
+    std::string name;              // unique in the scene (default: "field<index>")
     std::string exprPath;          // resolved against the scene's folder ("" when inline)
     std::string source;            // inline expression text (when exprPath is empty)
+    std::string preset;            // an embedded preset (fields/presets.h) when both are empty
+    // Where `source` starts in the scene file (1-based) when the TOML string holds it
+    // verbatim (no escapes), so its diagnostics point into the scene; 0 otherwise.
+    int sourceLine = 0, sourceCol = 0;
     std::map<std::string, Param> params; // overrides of the expression's parameters
     Param scale{1.0};
+    std::string mask;              // inline expression multiplying the field ("" for none)
+    int maskLine = 0, maskCol = 0; // as sourceLine/sourceCol, for `mask`
 };
 
 struct Scene {

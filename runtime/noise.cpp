@@ -1,271 +1,224 @@
-// Gradient noise in 1-4 dimensions, value and analytic derivatives, as branch-free lane loops:
-// lattice coordinates by truncation, an integer multiply-xorshift hash of primed coordinates,
-// gradients chosen by bit selects (icosahedron vertices in 3D, 24-cell vertices in 4D).
+// Entry points of the noise core for single noises: SIMD-level detection and dispatch, the
+// gradient noises (1-4D, derivatives, rotated, periodic), cell values, Voronoi features and
+// sin/cos. Each dispatching entry point runs one always-inline lane loop from noise_loops.h.
+#include <atomic>
+
 #include "runtime/noise.h"
-#include "runtime/noise_detail.h"
+#include "runtime/noise_loops.h"
 
 namespace gale::runtime::noise {
 
 using namespace detail;
+
+// ---- SIMD level ----------------------------------------------------------------------------
+
+namespace {
+std::atomic<int> gSimdLimit{static_cast<int>(Simd::Avx512)};
+}
+
+Simd detectedSimd() {
+    static const Simd level = [] {
+#if defined(GALE_NOISE_X86)
+        __builtin_cpu_init();
+        if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx2"))
+            return Simd::Avx512;
+        if (__builtin_cpu_supports("avx2")) return Simd::Avx2;
+        if (__builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt")) return Simd::Sse42;
+#endif
+        return Simd::Sse2;
+    }();
+    return level;
+}
+
+Simd simdLevel() {
+    const int limit = gSimdLimit.load(std::memory_order_relaxed);
+    const int detected = static_cast<int>(detectedSimd());
+    return static_cast<Simd>(detected < limit ? detected : limit);
+}
+
+void limitSimd(Simd max) { gSimdLimit.store(static_cast<int>(max), std::memory_order_relaxed); }
+
+const char* simdName(Simd s) {
+    switch (s) {
+    case Simd::Avx512: return "AVX-512";
+    case Simd::Avx2: return "AVX2";
+    case Simd::Sse42: return "SSE4.2";
+    default: return "SSE2";
+    }
+}
 
 uint32_t channelSeed(int channel, int octave) {
     return mixStrong(static_cast<uint32_t>(channel) * 0x9E3779B9u + static_cast<uint32_t>(octave) * 0x632BE5ABu +
                      0x1B873593u);
 }
 
+// ---- Bodies --------------------------------------------------------------------------------
+
 namespace {
 
-// ---- 1D and 2D -----------------------------------------------------------------------------
-
 template <class T>
-GALE_NOISE_INLINE T dot1(uint32_t h, T d) {
-    // A gradient uniform in [-1, 1].
-    return static_cast<T>(static_cast<int32_t>(h)) * T(1.0 / 2147483648.0) * d;
+GALE_NOISE_INLINE void gradient2Body(int n, const T* x, const T* y, uint32_t seed, T* out) {
+    gradient2Loop(n, x, y, seed, out);
 }
 
 template <class T>
-GALE_NOISE_INLINE T dot2(uint32_t h, T dx, T dy) {
-    // The eight directions of a regular octagon: axes and unit diagonals.
-    const T a = (h & 1u) ? -dx : dx;
-    const T b = (h & 2u) ? -dy : dy;
-    const T axis = (h & 4u) ? a : b;
-    const T diag = (a + b) * T(0.70710678118654752);
-    return (h & 8u) ? diag : axis;
+GALE_NOISE_INLINE void gradient3Body(int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds,
+                                     T* const* out) {
+    if (channels >= 3) gradient3Loop<T, 3>(n, x, y, z, seeds[0], seeds[1], seeds[2], out[0], out[1], out[2]);
+    else if (channels == 2) gradient3Loop<T, 2>(n, x, y, z, seeds[0], seeds[1], 0u, out[0], out[1], nullptr);
+    else gradient3Loop<T, 1>(n, x, y, z, seeds[0], 0u, 0u, out[0], nullptr, nullptr);
+}
+
+template <class T>
+GALE_NOISE_INLINE void gradient3DerivBody(int n, const T* x, const T* y, const T* z, uint32_t seed, T* value,
+                                          T* const* grad) {
+    gradient3DerivLoop(n, x, y, z, seed, value, grad[0], grad[1], grad[2]);
+}
+
+template <class T>
+GALE_NOISE_INLINE void gradient3RotatedBody(int n, const T* x, const T* y, const T* z, const T* const* rot,
+                                            uint32_t seed, T* value, T* const* grad) {
+    gradient3RotatedLoop(n, x, y, z, rot[0], rot[1], rot[2], rot[3], rot[4], rot[5], rot[6], rot[7], rot[8], seed,
+                         value, grad[0], grad[1], grad[2]);
+}
+
+template <class T>
+GALE_NOISE_INLINE void gradient4Body(int n, const T* x, const T* y, const T* z, const T* w, int channels,
+                                     const uint32_t* seeds, T* const* out) {
+    if (channels >= 3) gradient4Loop<T, 3>(n, x, y, z, w, seeds[0], seeds[1], seeds[2], out[0], out[1], out[2]);
+    else if (channels == 2) gradient4Loop<T, 2>(n, x, y, z, w, seeds[0], seeds[1], 0u, out[0], out[1], nullptr);
+    else gradient4Loop<T, 1>(n, x, y, z, w, seeds[0], 0u, 0u, out[0], nullptr, nullptr);
+}
+
+template <class T>
+GALE_NOISE_INLINE void gradient4DerivBody(int n, const T* x, const T* y, const T* z, const T* w, uint32_t seed,
+                                          T* value, T* const* grad) {
+    gradient4DerivLoop(n, x, y, z, w, seed, value, grad[0], grad[1], grad[2], grad[3]);
+}
+
+template <class T>
+GALE_NOISE_INLINE void cell3Body(int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds,
+                                 T* const* out) {
+    if (channels >= 3) cell3Loop<T, 3>(n, x, y, z, seeds[0], seeds[1], seeds[2], out[0], out[1], out[2]);
+    else if (channels == 2) cell3Loop<T, 2>(n, x, y, z, seeds[0], seeds[1], 0u, out[0], out[1], nullptr);
+    else cell3Loop<T, 1>(n, x, y, z, seeds[0], 0u, 0u, out[0], nullptr, nullptr);
+}
+
+template <class T>
+GALE_NOISE_INLINE void sinCosBody(int n, const T* x, T* s, T* c) {
+    sinCosLoop(n, x, s, c);
+}
+
+// One neighbour cell (ox, oy, oz) of every lane: its feature point, relative to the lane's
+// cell, against the nearest and second nearest so far. Strict comparisons: on a tie the cell
+// visited first wins (x outermost, then y, then z, as in SeExpr2).
+template <class T>
+GALE_NOISE_INLINE void voronoiStep(int m, int ox, int oy, int oz, const int32_t* __restrict cx,
+                                   const int32_t* __restrict cy, const int32_t* __restrict cz,
+                                   const T* __restrict fx, const T* __restrict fy, const T* __restrict fz,
+                                   const T* __restrict jit, T* __restrict f1, T* __restrict f2, T* __restrict p1x,
+                                   T* __restrict p1y, T* __restrict p1z, T* __restrict p2x, T* __restrict p2y,
+                                   T* __restrict p2z, T* __restrict k1x, T* __restrict k1y, T* __restrict k1z,
+                                   uint32_t s0, uint32_t s1, uint32_t s2) {
+    const T tx = T(ox), ty = T(oy), tz = T(oz);
+    for (int i = 0; i < m; ++i) {
+        const int32_t X = cx[i] + ox, Y = cy[i] + oy, Z = cz[i] + oz;
+        const T j = jit[i];
+        const T px = tx + T(0.5) + j * (cellValue<T>(X, Y, Z, s0) - T(0.5));
+        const T py = ty + T(0.5) + j * (cellValue<T>(X, Y, Z, s1) - T(0.5));
+        const T pz = tz + T(0.5) + j * (cellValue<T>(X, Y, Z, s2) - T(0.5));
+        const T dx = px - fx[i], dy = py - fy[i], dz = pz - fz[i];
+        const T d = dx * dx + dy * dy + dz * dz;
+        const T a1 = f1[i], a2 = f2[i];
+        using U = typename BitsOf<T>::U;
+        const U near1 = maskIf<T>(d < a1), near2 = maskIf<T>(d < a2);
+        f2[i] = pick(near1, a1, pick(near2, d, a2));
+        p2x[i] = pick(near1, p1x[i], pick(near2, px, p2x[i]));
+        p2y[i] = pick(near1, p1y[i], pick(near2, py, p2y[i]));
+        p2z[i] = pick(near1, p1z[i], pick(near2, pz, p2z[i]));
+        f1[i] = pick(near1, d, a1);
+        p1x[i] = pick(near1, px, p1x[i]);
+        p1y[i] = pick(near1, py, p1y[i]);
+        p1z[i] = pick(near1, pz, p1z[i]);
+        k1x[i] = pick(near1, tx, k1x[i]);
+        k1y[i] = pick(near1, ty, k1y[i]);
+        k1z[i] = pick(near1, tz, k1z[i]);
+    }
+}
+
+template <class T>
+GALE_NOISE_INLINE void voronoi3Body(int n, const T* x, const T* y, const T* z, const T* jitter,
+                                    const VoronoiLanes<T>& out) {
+    const uint32_t s0 = channelSeed(0), s1 = channelSeed(1), s2 = channelSeed(2);
+    for (int base = 0; base < n; base += kPass) {
+        const int m = n - base < kPass ? n - base : kPass;
+        alignas(64) int32_t cx[kPass], cy[kPass], cz[kPass];
+        alignas(64) T fx[kPass], fy[kPass], fz[kPass], jit[kPass], f1[kPass], f2[kPass];
+        alignas(64) T p1x[kPass], p1y[kPass], p1z[kPass], p2x[kPass], p2y[kPass], p2z[kPass];
+        alignas(64) T k1x[kPass], k1y[kPass], k1z[kPass];
+        for (int i = 0; i < m; ++i) {
+            split(x[base + i], cx[i], fx[i]);
+            split(y[base + i], cy[i], fy[i]);
+            split(z[base + i], cz[i], fz[i]);
+            jit[i] = jitter[base + i];
+            f1[i] = f2[i] = T(1000);
+            p1x[i] = p1y[i] = p1z[i] = p2x[i] = p2y[i] = p2z[i] = T(0);
+            k1x[i] = k1y[i] = k1z[i] = T(0);
+        }
+        for (int ox = -1; ox <= 1; ++ox)
+            for (int oy = -1; oy <= 1; ++oy)
+                for (int oz = -1; oz <= 1; ++oz)
+                    voronoiStep(m, ox, oy, oz, cx, cy, cz, fx, fy, fz, jit, f1, f2, p1x, p1y, p1z, p2x, p2y, p2z, k1x,
+                                k1y, k1z, s0, s1, s2);
+        for (int i = 0; i < m; ++i) {
+            const int o = base + i;
+            out.f1[o] = sqrtOf(f1[i]);
+            out.f2[o] = sqrtOf(f2[i]);
+            out.pos1[0][o] = T(cx[i]) + p1x[i];
+            out.pos1[1][o] = T(cy[i]) + p1y[i];
+            out.pos1[2][o] = T(cz[i]) + p1z[i];
+            out.pos2[0][o] = T(cx[i]) + p2x[i];
+            out.pos2[1][o] = T(cy[i]) + p2y[i];
+            out.pos2[2][o] = T(cz[i]) + p2z[i];
+            out.cell1[0][o] = cx[i] + static_cast<int32_t>(k1x[i]);
+            out.cell1[1][o] = cy[i] + static_cast<int32_t>(k1y[i]);
+            out.cell1[2][o] = cz[i] + static_cast<int32_t>(k1z[i]);
+        }
+    }
 }
 
 } // namespace
 
-template <class T>
-void gradient1(int n, const T* __restrict x, uint32_t seed, T* __restrict out) {
-    for (int i = 0; i < n; ++i) {
-        int32_t ix;
-        T fx;
-        split(x[i], ix, fx);
-        const uint32_t x0 = static_cast<uint32_t>(ix) * kPrimeX ^ seed;
-        const uint32_t x1 = (static_cast<uint32_t>(ix) * kPrimeX + kPrimeX) ^ seed;
-        const T a = dot1(mixHash(x0), fx);
-        const T b = dot1(mixHash(x1), fx - T(1));
-        out[i] = lerp(a, b, fade(fx)) * T(kScale1);
-    }
-}
+// ---- Entry points --------------------------------------------------------------------------
 
-template <class T>
-void gradient2(int n, const T* __restrict x, const T* __restrict y, uint32_t seed, T* __restrict out) {
-    for (int i = 0; i < n; ++i) {
-        int32_t ix, iy;
-        T fx, fy;
-        split(x[i], ix, fx);
-        split(y[i], iy, fy);
-        const uint32_t x0 = static_cast<uint32_t>(ix) * kPrimeX, x1 = x0 + kPrimeX;
-        const uint32_t y0 = (static_cast<uint32_t>(iy) * kPrimeY) ^ seed, y1 = (static_cast<uint32_t>(iy) * kPrimeY + kPrimeY) ^ seed;
-        const T gx = fx - T(1), gy = fy - T(1);
-        const T n00 = dot2(mixHash(x0 ^ y0), fx, fy);
-        const T n10 = dot2(mixHash(x1 ^ y0), gx, fy);
-        const T n01 = dot2(mixHash(x0 ^ y1), fx, gy);
-        const T n11 = dot2(mixHash(x1 ^ y1), gx, gy);
-        const T u = fade(fx), v = fade(fy);
-        out[i] = lerp(lerp(n00, n10, u), lerp(n01, n11, u), v) * T(kScale2);
-    }
-}
+GALE_NOISE_DISPATCH(gradient2, (int n, const T* x, const T* y, uint32_t seed, T* out), (n, x, y, seed, out))
+GALE_NOISE_DISPATCH(gradient3,
+                    (int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds, T* const* out),
+                    (n, x, y, z, channels, seeds, out))
+GALE_NOISE_DISPATCH(gradient3Deriv, (int n, const T* x, const T* y, const T* z, uint32_t seed, T* value, T* const* grad),
+                    (n, x, y, z, seed, value, grad))
+GALE_NOISE_DISPATCH(gradient3Rotated,
+                    (int n, const T* x, const T* y, const T* z, const T* const* rot, uint32_t seed, T* value,
+                     T* const* grad),
+                    (n, x, y, z, rot, seed, value, grad))
+GALE_NOISE_DISPATCH(gradient4,
+                    (int n, const T* x, const T* y, const T* z, const T* w, int channels, const uint32_t* seeds,
+                     T* const* out),
+                    (n, x, y, z, w, channels, seeds, out))
+GALE_NOISE_DISPATCH(gradient4Deriv,
+                    (int n, const T* x, const T* y, const T* z, const T* w, uint32_t seed, T* value, T* const* grad),
+                    (n, x, y, z, w, seed, value, grad))
+GALE_NOISE_DISPATCH(cell3, (int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds, T* const* out),
+                    (n, x, y, z, channels, seeds, out))
+GALE_NOISE_DISPATCH(voronoi3, (int n, const T* x, const T* y, const T* z, const T* jitter, const VoronoiLanes<T>& out),
+                    (n, x, y, z, jitter, out))
+GALE_NOISE_DISPATCH(sinCos, (int n, const T* x, T* s, T* c), (n, x, s, c))
 
-// ---- 3D ------------------------------------------------------------------------------------
-
-namespace {
-
-// One channel of 3D noise at a point whose lattice terms are already known.
-template <class T>
-GALE_NOISE_INLINE T value3(uint32_t a00, uint32_t a10, uint32_t a01, uint32_t a11, uint32_t z0, uint32_t z1, T fx,
-                           T fy, T fz, T gx, T gy, T gz, T u, T v, T w) {
-    const T n000 = dot3(mixHash(a00 ^ z0), fx, fy, fz);
-    const T n100 = dot3(mixHash(a10 ^ z0), gx, fy, fz);
-    const T n010 = dot3(mixHash(a01 ^ z0), fx, gy, fz);
-    const T n110 = dot3(mixHash(a11 ^ z0), gx, gy, fz);
-    const T n001 = dot3(mixHash(a00 ^ z1), fx, fy, gz);
-    const T n101 = dot3(mixHash(a10 ^ z1), gx, fy, gz);
-    const T n011 = dot3(mixHash(a01 ^ z1), fx, gy, gz);
-    const T n111 = dot3(mixHash(a11 ^ z1), gx, gy, gz);
-    const T c0 = lerp(lerp(n000, n100, u), lerp(n010, n110, u), v);
-    const T c1 = lerp(lerp(n001, n101, u), lerp(n011, n111, u), v);
-    return lerp(c0, c1, w) * T(kScale3);
-}
-
-template <class T, int C>
-void gradient3Pass(int n, const T* __restrict x, const T* __restrict y, const T* __restrict z, const uint32_t* seeds,
-                   T* const* out) {
-    const uint32_t s0 = seeds[0];
-    const uint32_t s1 = C > 1 ? seeds[1] : 0u;
-    const uint32_t s2 = C > 2 ? seeds[2] : 0u;
-    T* __restrict o0 = out[0];
-    T* __restrict o1 = C > 1 ? out[1] : nullptr;
-    T* __restrict o2 = C > 2 ? out[2] : nullptr;
-    for (int i = 0; i < n; ++i) {
-        int32_t ix, iy, iz;
-        T fx, fy, fz;
-        split(x[i], ix, fx);
-        split(y[i], iy, fy);
-        split(z[i], iz, fz);
-        const uint32_t x0 = static_cast<uint32_t>(ix) * kPrimeX, x1 = x0 + kPrimeX;
-        const uint32_t y0 = static_cast<uint32_t>(iy) * kPrimeY, y1 = y0 + kPrimeY;
-        const uint32_t z0 = static_cast<uint32_t>(iz) * kPrimeZ, z1 = z0 + kPrimeZ;
-        const uint32_t a00 = x0 ^ y0, a10 = x1 ^ y0, a01 = x0 ^ y1, a11 = x1 ^ y1;
-        const T gx = fx - T(1), gy = fy - T(1), gz = fz - T(1);
-        const T u = fade(fx), v = fade(fy), w = fade(fz);
-        o0[i] = value3(a00, a10, a01, a11, z0 ^ s0, z1 ^ s0, fx, fy, fz, gx, gy, gz, u, v, w);
-        if constexpr (C > 1) o1[i] = value3(a00, a10, a01, a11, z0 ^ s1, z1 ^ s1, fx, fy, fz, gx, gy, gz, u, v, w);
-        if constexpr (C > 2) o2[i] = value3(a00, a10, a01, a11, z0 ^ s2, z1 ^ s2, fx, fy, fz, gx, gy, gz, u, v, w);
-    }
-}
-
-// A corner's value and gradient, then multilinear interpolation carrying the derivative
-// (forward mode through each lerp: d(a + u(b - a)) = da + u(db - da) + du (b - a)).
-template <class T>
-struct VG {
-    T v, gx, gy, gz;
-};
-
-template <class T>
-GALE_NOISE_INLINE VG<T> corner3(uint32_t h, T dx, T dy, T dz) {
-    VG<T> r;
-    r.v = dot3(h, dx, dy, dz);
-    grad3(h, r.gx, r.gy, r.gz);
-    return r;
-}
-
-// Axis 0, 1, 2: which component receives du * (b - a).
-template <int Axis, class T>
-GALE_NOISE_INLINE VG<T> lerpVG(const VG<T>& a, const VG<T>& b, T u, T du) {
-    VG<T> r;
-    r.v = lerp(a.v, b.v, u);
-    r.gx = lerp(a.gx, b.gx, u);
-    r.gy = lerp(a.gy, b.gy, u);
-    r.gz = lerp(a.gz, b.gz, u);
-    const T slope = du * (b.v - a.v);
-    if constexpr (Axis == 0) r.gx = r.gx + slope;
-    if constexpr (Axis == 1) r.gy = r.gy + slope;
-    if constexpr (Axis == 2) r.gz = r.gz + slope;
-    return r;
-}
-
-template <class T>
-GALE_NOISE_INLINE VG<T> interpolate3(const VG<T>* c, T fx, T fy, T fz) {
-    const T u = fade(fx), v = fade(fy), w = fade(fz);
-    const T du = fadeDeriv(fx), dv = fadeDeriv(fy), dw = fadeDeriv(fz);
-    const VG<T> x00 = lerpVG<0>(c[0], c[1], u, du);
-    const VG<T> x10 = lerpVG<0>(c[2], c[3], u, du);
-    const VG<T> x01 = lerpVG<0>(c[4], c[5], u, du);
-    const VG<T> x11 = lerpVG<0>(c[6], c[7], u, du);
-    const VG<T> y0 = lerpVG<1>(x00, x10, v, dv);
-    const VG<T> y1 = lerpVG<1>(x01, x11, v, dv);
-    return lerpVG<2>(y0, y1, w, dw);
-}
-
-} // namespace
-
-template <class T>
-void gradient3(int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds, T* const* out) {
-    if (channels >= 3) gradient3Pass<T, 3>(n, x, y, z, seeds, out);
-    else if (channels == 2) gradient3Pass<T, 2>(n, x, y, z, seeds, out);
-    else gradient3Pass<T, 1>(n, x, y, z, seeds, out);
-}
-
-template <class T>
-void gradient3Deriv(int n, const T* __restrict x, const T* __restrict y, const T* __restrict z, uint32_t seed,
-                    T* __restrict value, T* const* grad) {
-    T* __restrict ox = grad[0];
-    T* __restrict oy = grad[1];
-    T* __restrict oz = grad[2];
-    for (int i = 0; i < n; ++i) {
-        int32_t ix, iy, iz;
-        T fx, fy, fz;
-        split(x[i], ix, fx);
-        split(y[i], iy, fy);
-        split(z[i], iz, fz);
-        const uint32_t x0 = static_cast<uint32_t>(ix) * kPrimeX, x1 = x0 + kPrimeX;
-        const uint32_t y0 = static_cast<uint32_t>(iy) * kPrimeY, y1 = y0 + kPrimeY;
-        const uint32_t z0 = (static_cast<uint32_t>(iz) * kPrimeZ) ^ seed, z1 = (static_cast<uint32_t>(iz) * kPrimeZ + kPrimeZ) ^ seed;
-        const T gx = fx - T(1), gy = fy - T(1), gz = fz - T(1);
-        VG<T> c[8];
-        c[0] = corner3(mixHash(x0 ^ y0 ^ z0), fx, fy, fz);
-        c[1] = corner3(mixHash(x1 ^ y0 ^ z0), gx, fy, fz);
-        c[2] = corner3(mixHash(x0 ^ y1 ^ z0), fx, gy, fz);
-        c[3] = corner3(mixHash(x1 ^ y1 ^ z0), gx, gy, fz);
-        c[4] = corner3(mixHash(x0 ^ y0 ^ z1), fx, fy, gz);
-        c[5] = corner3(mixHash(x1 ^ y0 ^ z1), gx, fy, gz);
-        c[6] = corner3(mixHash(x0 ^ y1 ^ z1), fx, gy, gz);
-        c[7] = corner3(mixHash(x1 ^ y1 ^ z1), gx, gy, gz);
-        const VG<T> r = interpolate3(c, fx, fy, fz);
-        value[i] = r.v * T(kScale3);
-        ox[i] = r.gx * T(kScale3);
-        oy[i] = r.gy * T(kScale3);
-        oz[i] = r.gz * T(kScale3);
-    }
-}
-
-template <class T>
-void gradient3Rotated(int n, const T* __restrict x, const T* __restrict y, const T* __restrict z,
-                      const T* const* rot, uint32_t seed, T* __restrict value, T* const* grad) {
-    const T* __restrict r00 = rot[0];
-    const T* __restrict r01 = rot[1];
-    const T* __restrict r02 = rot[2];
-    const T* __restrict r10 = rot[3];
-    const T* __restrict r11 = rot[4];
-    const T* __restrict r12 = rot[5];
-    const T* __restrict r20 = rot[6];
-    const T* __restrict r21 = rot[7];
-    const T* __restrict r22 = rot[8];
-    T* __restrict ox = grad[0];
-    T* __restrict oy = grad[1];
-    T* __restrict oz = grad[2];
-    for (int i = 0; i < n; ++i) {
-        int32_t ix, iy, iz;
-        T fx, fy, fz;
-        split(x[i], ix, fx);
-        split(y[i], iy, fy);
-        split(z[i], iz, fz);
-        const uint32_t x0 = static_cast<uint32_t>(ix) * kPrimeX, x1 = x0 + kPrimeX;
-        const uint32_t y0 = static_cast<uint32_t>(iy) * kPrimeY, y1 = y0 + kPrimeY;
-        const uint32_t z0 = (static_cast<uint32_t>(iz) * kPrimeZ) ^ seed, z1 = (static_cast<uint32_t>(iz) * kPrimeZ + kPrimeZ) ^ seed;
-        // The rotated gradient R g dotted with d equals g dotted with R^T d: rotate the offsets.
-        const T a00 = r00[i], a01 = r01[i], a02 = r02[i];
-        const T a10 = r10[i], a11 = r11[i], a12 = r12[i];
-        const T a20 = r20[i], a21 = r21[i], a22 = r22[i];
-        // q = R^T f, and the corner offsets R^T (f - corner) = q - R^T corner.
-        const T qx = a00 * fx + a10 * fy + a20 * fz;
-        const T qy = a01 * fx + a11 * fy + a21 * fz;
-        const T qz = a02 * fx + a12 * fy + a22 * fz;
-        T dx[8], dy[8], dz[8];
-        for (int k = 0; k < 8; ++k) {
-            // Corner k is (k & 1, (k >> 1) & 1, (k >> 2) & 1); R^T e_j is row j of R.
-            T cx = qx, cy = qy, cz = qz;
-            if (k & 1) { cx = cx - a00; cy = cy - a01; cz = cz - a02; }
-            if (k & 2) { cx = cx - a10; cy = cy - a11; cz = cz - a12; }
-            if (k & 4) { cx = cx - a20; cy = cy - a21; cz = cz - a22; }
-            dx[k] = cx; dy[k] = cy; dz[k] = cz;
-        }
-        const uint32_t h[8] = {mixHash(x0 ^ y0 ^ z0), mixHash(x1 ^ y0 ^ z0), mixHash(x0 ^ y1 ^ z0),
-                               mixHash(x1 ^ y1 ^ z0), mixHash(x0 ^ y0 ^ z1), mixHash(x1 ^ y0 ^ z1),
-                               mixHash(x0 ^ y1 ^ z1), mixHash(x1 ^ y1 ^ z1)};
-        VG<T> c[8];
-        for (int k = 0; k < 8; ++k) {
-            T gxl, gyl, gzl;
-            grad3(h[k], gxl, gyl, gzl);
-            c[k].v = dot3(h[k], dx[k], dy[k], dz[k]);
-            c[k].gx = a00 * gxl + a01 * gyl + a02 * gzl;
-            c[k].gy = a10 * gxl + a11 * gyl + a12 * gzl;
-            c[k].gz = a20 * gxl + a21 * gyl + a22 * gzl;
-        }
-        const VG<T> r = interpolate3(c, fx, fy, fz);
-        value[i] = r.v * T(kScale3);
-        ox[i] = r.gx * T(kScale3);
-        oy[i] = r.gy * T(kScale3);
-        oz[i] = r.gz * T(kScale3);
-    }
-}
-
+// Periodic noise is rare: one lane at a time (integer remainders do not vectorise on SSE2).
 template <class T>
 void gradient3Periodic(int n, const T* x, const T* y, const T* z, const int32_t* px, const int32_t* py,
                        const int32_t* pz, uint32_t seed, T* out) {
-    // Rarely used: one lane at a time (integer remainders do not vectorise on SSE2).
     auto wrap = [](int32_t i, int32_t p, uint32_t& c0, uint32_t& c1) {
         if (p < 1) p = 1;
         int32_t r = i % p;
@@ -292,13 +245,17 @@ void gradient3Periodic(int n, const T* x, const T* y, const T* z, const int32_t*
 }
 
 #define GALE_NOISE_INSTANTIATE(T)                                                                                 \
-    template void gradient1<T>(int, const T*, uint32_t, T*);                                                       \
     template void gradient2<T>(int, const T*, const T*, uint32_t, T*);                                             \
     template void gradient3<T>(int, const T*, const T*, const T*, int, const uint32_t*, T* const*);               \
     template void gradient3Deriv<T>(int, const T*, const T*, const T*, uint32_t, T*, T* const*);                  \
     template void gradient3Rotated<T>(int, const T*, const T*, const T*, const T* const*, uint32_t, T*, T* const*); \
     template void gradient3Periodic<T>(int, const T*, const T*, const T*, const int32_t*, const int32_t*,          \
-                                       const int32_t*, uint32_t, T*);
+                                       const int32_t*, uint32_t, T*);                                              \
+    template void gradient4<T>(int, const T*, const T*, const T*, const T*, int, const uint32_t*, T* const*);     \
+    template void gradient4Deriv<T>(int, const T*, const T*, const T*, const T*, uint32_t, T*, T* const*);        \
+    template void cell3<T>(int, const T*, const T*, const T*, int, const uint32_t*, T* const*);                   \
+    template void voronoi3<T>(int, const T*, const T*, const T*, const T*, const VoronoiLanes<T>&);               \
+    template void sinCos<T>(int, const T*, T*, T*);
 
 GALE_NOISE_INSTANTIATE(float)
 GALE_NOISE_INSTANTIATE(double)

@@ -1,4 +1,4 @@
-// The noise core: gradient noise in 1-4 dimensions (with analytic derivatives), cellular and
+// The noise core: gradient noise in 2-4 dimensions (with analytic derivatives), cellular and
 // Voronoi noise, and the fractal sums built on them, computed for many points per call in
 // structure-of-arrays form so that the lane loops vectorise. Integer hashing, no table lookups.
 #pragma once
@@ -13,15 +13,20 @@ constexpr int kPass = 256;
 // Octave counts are clamped to this range (SeExpr2: octaves = int(clamp(octaves, 1, 8))).
 constexpr int kMaxOctaves = 8;
 
+// The SIMD level the lane loops run at: chosen by CPUID (every level gives identical bits).
+enum class Simd { Sse2 = 0, Sse42 = 1, Avx2 = 2, Avx512 = 3 };
+Simd detectedSimd();   // the best level this CPU supports
+Simd simdLevel();      // the level in use: detectedSimd(), capped by limitSimd()
+void limitSimd(Simd max); // tests and benchmarks: run at most at this level (process-wide)
+const char* simdName(Simd s);
+
 // Seeds: channel k of a multi-channel noise, octave o of a fractal sum. Independent seeds play
 // the role of SeExpr2's P + 1000k channel offset without costing float precision.
 uint32_t channelSeed(int channel, int octave = 0);
 
-// ---- Gradient noise (signed; 0 on lattice points; quintic fade; rms ~0.19, |n| < ~0.75) ----
+// ---- Gradient noise (signed; 0 on lattice points; quintic fade; rms 0.19, |n| < ~0.75) -----
 
-// 1D and 2D forms (noise(x, y)).
-template <class T>
-void gradient1(int n, const T* x, uint32_t seed, T* out);
+// The 2D form (noise(x, y)).
 template <class T>
 void gradient2(int n, const T* x, const T* y, uint32_t seed, T* out);
 
@@ -60,9 +65,9 @@ void gradient4Deriv(int n, const T* x, const T* y, const T* z, const T* w, uint3
 template <class T>
 void cell3(int n, const T* x, const T* y, const T* z, int channels, const uint32_t* seeds, T* const* out);
 
-// Worley/Voronoi: one feature point per cell at cell + 0.5 + jitter * (random - 0.5); the
-// nearest (f1, pos1) and second nearest (f2, pos2) of the 27 cells around each point, and the
-// nearest point's cell (an integer triple, as T). jitter is per lane, in [1e-3, 1].
+// Worley/Voronoi: one feature point per cell c at c + 0.5 + jitter * (cell3(c) - 0.5); the
+// distances to the nearest (f1, pos1) and second nearest (f2, pos2) of the 27 cells around each
+// point, and the nearest point's cell. jitter is per lane (the caller clamps it to [1e-3, 1]).
 template <class T>
 struct VoronoiLanes {
     T* f1;
@@ -97,7 +102,8 @@ void fbm4(int n, const T* x, const T* y, const T* z, const T* w, const FractalLa
 
 // Curl noise (Bridson, Hourihan, Nordenstam 2007): curl of the vector potential
 // psi = Σ_o (gain/lacunarity)^o N_o(P_o), three independent gradient noises, so that octave o
-// contributes gain^o times a unit-frequency curl field. Divergence-free by construction.
+// contributes gain^o times a unit-frequency curl field. Divergence-free by construction. Scaled
+// so that one octave has component rms 0.19 (like vnoise).
 template <class T>
 void curl3(int n, const T* x, const T* y, const T* z, const FractalLanes<T>& f, T* const* out);
 // The same with a 4D potential N(P_o, t_o); the curl is taken in space.

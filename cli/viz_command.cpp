@@ -1,0 +1,314 @@
+// `gale viz`: a picture (PNG or SVG) of a slice of the wind: speed colours with a legend,
+// arrows or streamlines, and, for scenes, the windicator, gust fronts and a gust timeline.
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "cli/field_input.h"
+#include "cli/render.h"
+#include "fields/grid_sample.h"
+#include "fields/rigs.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace gale::cli {
+
+namespace {
+
+// "z=0" -> axis 2, value 0.
+bool parsePlane(const std::string& text, int& axis, double& value, std::string& error) {
+    const size_t eq = text.find('=');
+    std::string name = eq == std::string::npos ? text : text.substr(0, eq);
+    name.erase(
+        std::remove_if(name.begin(), name.end(), [](unsigned char c) { return std::isspace(c); }),
+        name.end());
+    std::vector<double> v;
+    if (eq == std::string::npos || name.size() != 1 ||
+        std::string("xyzXYZ").find(name[0]) == std::string::npos ||
+        !parseNumbers(text.substr(eq + 1), 1, "--plane", v, error)) {
+        error = "--plane '" + text + "': expected x=C, y=C or z=C (metres), e.g. z=0";
+        return false;
+    }
+    axis = std::tolower(static_cast<unsigned char>(name[0])) - 'x';
+    value = v[0];
+    return true;
+}
+
+// "1024x768" (or one number for a square).
+bool parseSize(const std::string& text, int& w, int& h, std::string& error) {
+    const size_t x = text.find_first_of("xX");
+    std::vector<double> a, b;
+    std::string e;
+    bool ok = x == std::string::npos ? parseNumbers(text, 1, "--size", a, e)
+                                     : parseNumbers(text.substr(0, x), 1, "--size", a, e) &&
+                                           parseNumbers(text.substr(x + 1), 1, "--size", b, e);
+    if (ok) {
+        w = static_cast<int>(a[0]);
+        h = static_cast<int>(b.empty() ? a[0] : b[0]);
+        ok = a[0] == w && (b.empty() || b[0] == h) && w >= 200 && h >= 150 && w <= 16384 &&
+             h <= 16384;
+    }
+    if (!ok)
+        error = "--size '" + text +
+                "': expected WIDTHxHEIGHT in pixels, from 200x150 to "
+                "16384x16384 (e.g. 1024x1024)";
+    return ok;
+}
+
+// Up to 3 decimals without trailing zeros: 28.8, 24, 0.125.
+std::string shortNumber(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", v);
+    std::string out = buf;
+    while (out.back() == '0') out.pop_back();
+    if (out.back() == '.') out.pop_back();
+    return out == "-0" ? "0" : out;
+}
+
+std::string axisName(int a) {
+    return std::string(1, static_cast<char>('x' + a));
+}
+
+// Samples of a gust's strength * envelope at the origin plane, from just before its start to
+// just after it has died away.
+TimelineOverlay::Curve gustCurve(const fields::Gust& g, const std::string& label) {
+    TimelineOverlay::Curve c;
+    c.label = label;
+    const double total = g.attack + g.hold + g.decay;
+    const int n = 96;
+    for (int i = 0; i <= n; ++i) {
+        const double tau = total * i / n;
+        const double t = g.start + tau;
+        // At tau = total the envelope is back to 0; at 0 it starts from 0.
+        c.points.push_back(
+            {t, g.strength.scalarAt(t) * fields::gustEnvelope(g, std::min(tau, total - 1e-12))});
+    }
+    c.points.front()[1] = 0.0;
+    c.points.back()[1] = 0.0;
+    return c;
+}
+
+SliceOverlays sceneOverlays(const fields::Scene& scene, double t) {
+    SliceOverlays o;
+    const fields::Windicator w = scene.windicator.value_or(fields::Windicator{});
+    const fields::Vec3 dir = fields::windDirectionAt(w, t);
+    if (scene.windicator) {
+        o.windicator.present = true;
+        o.windicator.direction = {dir[0], dir[1], dir[2]};
+        o.windicator.speed = w.speed.scalarAt(t);
+    }
+    TimelineOverlay& tl = o.timeline;
+    const double fps = scene.settings.fps > 0 ? scene.settings.fps : 24.0;
+    tl.sceneStart = scene.settings.frameStart / fps;
+    tl.sceneEnd = scene.settings.frameEnd / fps;
+    tl.t0 = std::min({tl.sceneStart, t, 0.0});
+    tl.t1 = std::max(tl.sceneEnd, t);
+    for (size_t i = 0; i < scene.gusts.size(); ++i) {
+        const fields::Gust& g = scene.gusts[i];
+        const std::string label = g.name.empty() ? "gust " + std::to_string(i + 1) : g.name;
+        tl.gusts.push_back(gustCurve(g, label));
+        tl.t0 = std::min(tl.t0, g.start);
+        tl.t1 = std::max(tl.t1, g.start + g.attack + g.hold + g.decay);
+        if (g.travelSpeed > 0 && (dir[0] != 0 || dir[1] != 0 || dir[2] != 0)) {
+            GustBand band;
+            band.label = label;
+            band.direction = {dir[0], dir[1], dir[2]};
+            band.front = (t - g.start) * g.travelSpeed;
+            band.tail = (t - g.start - (g.attack + g.hold + g.decay)) * g.travelSpeed;
+            o.gusts.push_back(band);
+        }
+    }
+    tl.present = !scene.gusts.empty() || (scene.windicator && w.speed.isKeyed());
+    if (scene.windicator) {
+        tl.windicatorSpeed.label = "windicator";
+        const int n = 240;
+        for (int i = 0; i <= n; ++i) {
+            const double s = tl.t0 + (tl.t1 - tl.t0) * i / n;
+            tl.windicatorSpeed.points.push_back({s, w.speed.scalarAt(s)});
+        }
+    }
+    return o;
+}
+
+} // namespace
+
+int runViz(const VizOptions& o) {
+    std::string error;
+    int normal = 2;
+    double planeValue = 0.0;
+    if (!parsePlane(o.plane, normal, planeValue, error)) {
+        printError(error);
+        return kExitUsage;
+    }
+    std::vector<double> b;
+    if (!parseNumbers(o.bounds, 4, "--bounds", b, error)) {
+        printError(error + " (u0,v0,u1,v1 in the plane's axes)");
+        return kExitUsage;
+    }
+    // The plane's axes as drawn (u right, v up): z=C shows x,y; y=C shows x,z; x=C shows z,y.
+    const int uAxis = normal == 2 ? 0 : normal == 1 ? 0 : 2;
+    const int vAxis = normal == 2 ? 1 : normal == 1 ? 2 : 1;
+    if (!(b[2] > b[0]) || !(b[3] > b[1])) {
+        printError("--bounds '" + o.bounds + "': expected " + axisName(uAxis) + "0," +
+                   axisName(vAxis) + "0," + axisName(uAxis) + "1," + axisName(vAxis) + "1 with " +
+                   axisName(uAxis) + "1 > " + axisName(uAxis) + "0 and " + axisName(vAxis) +
+                   "1 > " + axisName(vAxis) + "0");
+        return kExitUsage;
+    }
+    int width = 0, height = 0;
+    if (!parseSize(o.size, width, height, error)) {
+        printError(error);
+        return kExitUsage;
+    }
+    ImageFormat format;
+    if (!imageFormatFromPath(o.output, format)) {
+        printError("cannot tell the picture format from '" + o.output +
+                   "': use a .png or .svg name");
+        return kExitUsage;
+    }
+    if (o.fps < 0 || !std::isfinite(o.fps) || !std::isfinite(o.time) || o.speedMax < 0 ||
+        !std::isfinite(o.speedMax) || o.arrowSpacing < 0 || !std::isfinite(o.arrowSpacing)) {
+        printError(
+            "--fps, --speed-max and --arrow-spacing must be positive numbers, --time finite");
+        return kExitUsage;
+    }
+
+    FieldInput input;
+    if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
+    const double t = o.time;
+    SliceOverlays overlays;
+    if (input.scene) overlays = sceneOverlays(*input.scene, t);
+
+    SliceLayout layout;
+    if (!layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present, layout)) {
+        printError("--size " + o.size + " is too small for a picture of these bounds");
+        return kExitUsage;
+    }
+    Slice slice;
+    slice.nu = layout.plotW;
+    slice.nv = layout.plotH;
+    slice.bounds = {b[0], b[1], b[2], b[3]};
+    slice.uAxis = uAxis;
+    slice.vAxis = vAxis;
+    slice.normalAxis = normal;
+    slice.planeValue = planeValue;
+    const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
+    std::vector<double> positions(3 * n), velocities(3 * n, 0.0);
+    for (int row = 0; row < slice.nv; ++row)
+        for (int col = 0; col < slice.nu; ++col) {
+            double* p = positions.data() + 3 * (static_cast<size_t>(row) * slice.nu + col);
+            p[uAxis] = b[0] + (col + 0.5) / slice.nu * (b[2] - b[0]);
+            p[vAxis] = b[3] - (row + 0.5) / slice.nv * (b[3] - b[1]);
+            p[normal] = planeValue;
+        }
+    fields::SampleTime when;
+    when.time = t;
+    when.fps = input.fps;
+    when.threads = o.threads;
+    fields::GridSampleOptions sampling;
+    sampling.threads = o.threads;
+    fields::SampleStatus status =
+        fields::samplePoints(*input.field, positions.data(), n, when, velocities.data(), sampling);
+    if (!status.ok) {
+        printError("cannot sample " + input.name + ": " + status.message);
+        return kExitInput;
+    }
+    if (status.nonFinite > 0) {
+        printError(std::to_string(status.nonFinite) + " of " + std::to_string(n) +
+                   " sample(s) of " + input.name + " gave a non-finite velocity at t = " +
+                   formatValue(t, false) + " s; no picture was written");
+        return kExitNumeric;
+    }
+    slice.velocity.resize(3 * n);
+    for (size_t i = 0; i < 3 * n; ++i) slice.velocity[i] = static_cast<float>(velocities[i]);
+
+    RenderSettings settings;
+    settings.format = format;
+    settings.title = input.name;
+    settings.subtitle = "slice " + axisName(normal) + " = " + formatValue(planeValue, false) +
+                        " m   \u00b7   t = " + shortNumber(t) + " s (frame " +
+                        shortNumber(t * input.fps) + " at " + shortNumber(input.fps) + " fps)";
+    settings.time = t;
+    settings.style = o.style == "streamlines" ? FlowStyle::Streamlines
+                     : o.style == "none"      ? FlowStyle::None
+                                              : FlowStyle::Arrows;
+    settings.speedMax = o.speedMax;
+    settings.arrowSpacing = o.arrowSpacing;
+    fields::IoError e = renderSlice(o.output, layout, slice, overlays, settings);
+    if (e) {
+        std::cerr << e.render() << '\n';
+        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+    }
+    return kExitOk;
+}
+
+Command addVizCommand(CLI::App& app) {
+    auto o = std::make_shared<VizOptions>();
+    CLI::App* sub = app.add_subcommand(
+        "viz", "Draw a slice of the wind as a PNG or SVG picture: colour = speed (viridis, with "
+               "a legend in m/s), arrows or streamlines for the in-plane direction, and for "
+               "scenes the windicator arrow, gust fronts and a gust timeline.");
+    CLI::Option* file =
+        sub->add_option("file", o->source.file,
+                        "Expression file (.se; '-' reads stdin) or scene file (.toml)")
+            ->type_name("FILE|SCENE");
+    CLI::Option* expr =
+        sub->add_option("-e,--expr", o->source.expr, "Expression text instead of a file")
+            ->type_name("EXPR");
+    file->excludes(expr);
+    expr->excludes(file);
+    sub->add_option("--set", o->source.sets,
+                    "Expression: override parameter (or bind variable) $NAME with a number or "
+                    "x,y,z. Scene: override a key by its dotted path (windicator.speed=12). "
+                    "Repeatable")
+        ->type_name("NAME=VALUE")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    sub->add_option("--plane", o->plane,
+                    "The slice: z=C (drawn with x right, y up), y=C (x right, z up) or x=C (z "
+                    "right, y up)")
+        ->type_name("PLANE")
+        ->capture_default_str();
+    sub->add_option("--bounds", o->bounds,
+                    "The slice's extent in metres along the drawn axes: u0,v0,u1,v1 (for z=C: "
+                    "x0,y0,x1,y1)")
+        ->type_name("BOX")
+        ->required();
+    sub->add_option("--time", o->time, "$t in seconds")->capture_default_str()->type_name("T");
+    sub->add_option("--fps", o->fps, "Frames per second (default: the scene's, else 24)")
+        ->type_name("FPS");
+    sub->add_option("--size", o->size, "Picture size in pixels")
+        ->type_name("WxH")
+        ->capture_default_str();
+    sub->add_option("-o,--output", o->output,
+                    "The picture: .png or .svg (written to a temporary file and renamed)")
+        ->type_name("OUT")
+        ->required();
+    sub->add_option("--style", o->style, "Direction marks: arrows, streamlines or none")
+        ->type_name("STYLE")
+        ->check(CLI::IsMember({"arrows", "streamlines", "none"}))
+        ->capture_default_str();
+    sub->add_option("--speed-max", o->speedMax,
+                    "Top of the colour scale in m/s, to compare pictures (default: a round "
+                    "number above the slice's maximum)")
+        ->type_name("V");
+    sub->add_option("--arrow-spacing", o->arrowSpacing,
+                    "Pixels between arrows or streamlines (default: about 22 across)")
+        ->type_name("PX");
+    sub->add_option("--threads", o->threads, "Threads (default 0 = all hardware threads)")
+        ->type_name("N")
+        ->check(CLI::Range(0, 4096));
+    sub->footer("Arrows show the in-plane part of the wind, scaled to the largest (see the\n"
+                "key); the colour is the full 3-D speed. Scenes add the windicator arrow, the\n"
+                "front and tail of every gust crossing the slice, and a gust timeline.\n"
+                "Exit codes: 1 bad expression or scene, 2 bad flags, 3 unwritable picture,\n"
+                "4 non-finite velocities (no picture written).");
+    return {sub, [o] { return runViz(*o); }};
+}
+
+} // namespace gale::cli

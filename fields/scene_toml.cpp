@@ -1,0 +1,867 @@
+// Loading the wind part of a scene file with toml++ (the only file that includes it: it is slow
+// to compile): --set overrides applied to the TOML tree by dotted path, then every key checked
+// and converted, with every problem reported at its file:line:col.
+#include "fields/expression_field.h"
+#include "fields/pointset.h"
+#include "fields/presets.h"
+#include "fields/scene.h"
+#include "lang/functions.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+
+namespace gale::fields {
+
+namespace {
+
+constexpr std::string_view kSetPrefix = "--set ";
+
+std::string trim(std::string_view s) {
+    size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
+    return a == std::string_view::npos ? std::string() : std::string(s.substr(a, b - a + 1));
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> parts;
+    std::string part;
+    std::stringstream in(s);
+    while (std::getline(in, part, sep)) parts.push_back(part);
+    if (!s.empty() && s.back() == sep) parts.push_back("");
+    return parts;
+}
+
+std::string joinNames(const std::vector<std::string>& names) {
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+}
+
+// "did you mean 'x'?" among `candidates`, or empty.
+std::string didYouMean(const std::string& name, const std::vector<std::string>& candidates) {
+    std::vector<std::string_view> views(candidates.begin(), candidates.end());
+    std::string_view close = lang::closestName(name, views);
+    return close.empty() ? std::string() : "did you mean '" + std::string(close) + "'?";
+}
+
+bool isNumber(const toml::node& n) { return n.is_integer() || n.is_floating_point(); }
+
+const char* typeName(const toml::node& n) {
+    switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    default: return "nothing";
+    }
+}
+
+class Loader {
+public:
+    Loader(const std::string& path, const std::string& text, std::vector<SceneError>& errors,
+           const SceneLoadOptions& options)
+        : mPath(path), mText(text), mErrors(errors), mOptions(options) {
+        size_t start = 0;
+        for (;;) {
+            mLineStarts.push_back(start);
+            size_t nl = text.find('\n', start);
+            if (nl == std::string::npos) break;
+            start = nl + 1;
+        }
+    }
+
+    void applySets(toml::table& root);
+    void load(const toml::table& root, Scene& out);
+
+    // ---- error reporting ----
+    SceneError& error(const toml::source_region& where, std::string message) {
+        SceneError e;
+        e.message = std::move(message);
+        if (where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
+            e.file = *where.path;
+        } else {
+            e.file = mPath;
+            e.line = static_cast<int>(where.begin.line);
+            e.col = static_cast<int>(where.begin.column);
+            e.sourceLine = lineText(e.line);
+        }
+        mErrors.push_back(std::move(e));
+        return mErrors.back();
+    }
+    SceneError& error(const toml::node& at, std::string message) {
+        return error(at.source(), std::move(message));
+    }
+    SceneError& setError(const std::string& set, std::string message) {
+        SceneError e;
+        e.file = std::string(kSetPrefix) + set;
+        e.message = std::move(message);
+        mErrors.push_back(std::move(e));
+        return mErrors.back();
+    }
+
+private:
+    std::string lineText(int line) const {
+        if (line <= 0 || static_cast<size_t>(line) > mLineStarts.size()) return {};
+        const size_t a = mLineStarts[static_cast<size_t>(line - 1)];
+        size_t b = mText.find('\n', a);
+        if (b == std::string::npos) b = mText.size();
+        if (b > a && mText[b - 1] == '\r') --b;
+        return mText.substr(a, b - a);
+    }
+
+    // Byte offset of a toml++ position (columns count code points).
+    size_t offsetOf(const toml::source_position& p) const {
+        if (p.line == 0 || p.line > mLineStarts.size()) return std::string::npos;
+        size_t i = mLineStarts[p.line - 1];
+        for (uint32_t c = 1; c < p.column && i < mText.size(); ++c) {
+            ++i;
+            while (i < mText.size() && (static_cast<unsigned char>(mText[i]) & 0xC0) == 0x80) ++i;
+        }
+        return i;
+    }
+
+    void checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                   const std::string& section);
+    bool number(const toml::node& n, const std::string& what, double& out);
+    bool integer(const toml::node& n, const std::string& what, long long& out);
+    bool string(const toml::node& n, const std::string& what, std::string& out);
+    std::optional<Param> param(const toml::node& n, const std::string& what, int width);
+    std::optional<Param> keyframes(const toml::table& t, const std::string& what, int width);
+    bool vectorValue(const toml::node& n, std::vector<double>& out);
+    void verbatimPosition(const toml::node& n, const std::string& value, int& line, int& col) const;
+
+    void loadSettings(const toml::table& t, SceneSettings& s);
+    void loadWindicator(const toml::table& t, Windicator& w);
+    void loadGust(const toml::table& t, size_t index, Gust& g);
+    void loadField(const toml::table& t, size_t index, const std::string& baseDir,
+                   FieldEntry& f);
+    void checkParams(const toml::table& params, const FieldEntry& f, const Scene& scene,
+                     const toml::node* sourceNode);
+
+    std::string mPath;
+    const std::string& mText;
+    std::vector<size_t> mLineStarts;
+    std::vector<SceneError>& mErrors;
+    const SceneLoadOptions& mOptions;
+};
+
+// ---- --set KEY=VALUE ------------------------------------------------------------------------
+
+void Loader::applySets(toml::table& root) {
+    for (const std::string& set : mOptions.sets) {
+        const size_t eq = set.find('=');
+        const std::string key = trim(eq == std::string::npos ? set : set.substr(0, eq));
+        const std::string text = eq == std::string::npos ? std::string() : trim(set.substr(eq + 1));
+        const std::vector<std::string> parts = split(key, '.');
+        if (eq == std::string::npos || key.empty() || text.empty() ||
+            std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
+            setError(set, "expected KEY=VALUE with a dotted scene path, e.g. windicator.speed=12, "
+                          "field.main.params.speed=8 or scene.fps=30");
+            continue;
+        }
+        const std::string& head = parts[0];
+        if (std::find(mOptions.foreignSections.begin(), mOptions.foreignSections.end(), head) !=
+            mOptions.foreignSections.end())
+            continue; // the solver's loader applies it
+
+        // The value as TOML (`12`, `[1, 0, 0]`, `{ keys = ... }`, `"text"`), else a comma list of
+        // numbers (`1,0,0`), else a bare string (`smooth`).
+        const std::string origin = std::string(kSetPrefix) + set;
+        toml::table doc;
+        bool parsed = false;
+        for (const std::string& candidate : {text, "[" + text + "]"}) {
+            try {
+                doc = toml::parse("v = " + candidate, origin);
+                parsed = true;
+                break;
+            } catch (const toml::parse_error&) {
+            }
+        }
+        if (!parsed) {
+            std::string quoted = "\"";
+            for (char c : text) {
+                if (c == '"' || c == '\\') quoted += '\\';
+                quoted += c;
+            }
+            try {
+                doc = toml::parse("v = " + quoted + "\"", origin);
+                parsed = true;
+            } catch (const toml::parse_error&) {
+            }
+        }
+        if (!parsed || !doc.get("v")) {
+            setError(set, "cannot read the value '" + text + "'");
+            continue;
+        }
+
+        toml::table* target = nullptr;
+        size_t next = 1;
+        std::string where = head;
+        if (head == "scene" || head == "windicator") {
+            if (!root.contains(head)) root.insert(head, toml::table{});
+            target = root.get(head)->as_table();
+            if (!target) {
+                setError(set, "'" + head + "' in the scene is not a table");
+                continue;
+            }
+        } else if (head == "gust" || head == "field") {
+            toml::array* list = root.get(head) ? root.get(head)->as_array() : nullptr;
+            if (parts.size() < 3) {
+                setError(set, "expected " + head + ".NAME.KEY (or " + head + ".INDEX.KEY, from 0)");
+                continue;
+            }
+            std::vector<std::string> names;
+            if (list) {
+                for (size_t i = 0; i < list->size(); ++i) {
+                    toml::table* t = list->get(i)->as_table();
+                    if (!t) continue;
+                    std::string name =
+                        t->get("name") && t->get("name")->is_string()
+                            ? t->get("name")->value<std::string>().value_or("")
+                            : (head == "field" ? "field" + std::to_string(i) : std::string());
+                    if (!name.empty()) names.push_back(name);
+                    const bool byIndex = parts[1] == std::to_string(i);
+                    if (!target && (name == parts[1] || byIndex)) target = t;
+                }
+            }
+            if (!target) {
+                SceneError& e = setError(set, "the scene has no [[" + head + "]] named '" +
+                                                  parts[1] + "'");
+                std::string hint = didYouMean(parts[1], names);
+                if (!hint.empty()) e.notes.push_back(hint);
+                const size_t count = list ? list->size() : 0;
+                e.notes.push_back("it has " + std::to_string(count) + " [[" + head + "]] entr" +
+                                  (count == 1 ? "y" : "ies") +
+                                  (names.empty() ? std::string()
+                                                 : " (" + joinNames(names) + ")") +
+                                  "; name one, or give its index from 0");
+                continue;
+            }
+            next = 2;
+            where = head + "." + parts[1];
+        } else {
+            SceneError& e = setError(set, "unknown scene section '" + head + "'");
+            std::vector<std::string> known = {"scene", "windicator", "gust", "field"};
+            std::string hint = didYouMean(head, known);
+            if (!hint.empty()) e.notes.push_back(hint);
+            e.notes.push_back("scene paths look like windicator.speed, scene.fps, "
+                              "gust.NAME.strength or field.NAME.params.PARAM");
+            continue;
+        }
+        bool ok = true;
+        for (size_t i = next; ok && i + 1 < parts.size(); ++i) {
+            where += "." + parts[i];
+            toml::node* child = target->get(parts[i]);
+            if (!child) {
+                target->insert(parts[i], toml::table{});
+                child = target->get(parts[i]);
+            }
+            target = child->as_table();
+            if (!target) {
+                setError(set, "'" + where + "' is " + typeName(*child) + ", not a table");
+                ok = false;
+            }
+        }
+        if (ok) target->insert_or_assign(parts.back(), std::move(*doc.get("v")));
+    }
+}
+
+// ---- Values -----------------------------------------------------------------------------------
+
+void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                       const std::string& section) {
+    for (auto&& [key, node] : t) {
+        const std::string name(key.str());
+        if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
+        SceneError& e = error(key.source().begin.line ? key.source() : node.source(),
+                              "unknown key '" + name + "' in " + section);
+        std::string hint = didYouMean(name, allowed);
+        if (!hint.empty()) e.notes.push_back(hint);
+        e.notes.push_back(section + " keys: " + joinNames(allowed));
+    }
+}
+
+bool Loader::number(const toml::node& n, const std::string& what, double& out) {
+    if (!isNumber(n)) {
+        error(n, what + " must be a number, not " + typeName(n));
+        return false;
+    }
+    const double v = n.value<double>().value_or(0.0);
+    if (!std::isfinite(v)) {
+        error(n, what + " must be a finite number");
+        return false;
+    }
+    out = v;
+    return true;
+}
+
+bool Loader::integer(const toml::node& n, const std::string& what, long long& out) {
+    double v = 0.0;
+    if (n.is_integer()) {
+        out = n.value<long long>().value_or(0);
+        return true;
+    }
+    if (n.is_floating_point() && number(n, what, v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+        out = static_cast<long long>(v);
+        return true;
+    }
+    error(n, what + " must be a whole number, not " +
+                 (n.is_floating_point() ? std::string("a fraction") : typeName(n)));
+    return false;
+}
+
+bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
+    if (!n.is_string()) {
+        error(n, what + " must be a string, not " + typeName(n));
+        return false;
+    }
+    out = n.value<std::string>().value_or("");
+    return true;
+}
+
+// A number or an array of numbers (false without a report: the caller words the error).
+bool Loader::vectorValue(const toml::node& n, std::vector<double>& out) {
+    out.clear();
+    if (isNumber(n)) {
+        out.push_back(n.value<double>().value_or(0.0));
+        return std::isfinite(out[0]);
+    }
+    const toml::array* a = n.as_array();
+    if (!a || a->empty() || a->size() > static_cast<size_t>(lang::kMaxWidth)) return false;
+    for (const toml::node& e : *a) {
+        if (!isNumber(e)) return false;
+        out.push_back(e.value<double>().value_or(0.0));
+        if (!std::isfinite(out.back())) return false;
+    }
+    return true;
+}
+
+std::string widthText(int width) {
+    return width == 1 ? std::string("a number")
+                      : "a vector of " + std::to_string(width) + " numbers";
+}
+
+// A numeric parameter: a number, a vector, or a keyframed curve. `width` 0 accepts any width.
+std::optional<Param> Loader::param(const toml::node& n, const std::string& what, int width) {
+    if (const toml::table* t = n.as_table()) return keyframes(*t, what, width);
+    std::vector<double> v;
+    if (!vectorValue(n, v)) {
+        error(n, what + " must be " +
+                     (width ? widthText(width) : std::string("a number or a vector [x, y, z]")) +
+                     " or a keyframed curve { keys = [[t0, v0], [t1, v1]], interp = \"linear\" }" +
+                     (n.is_array() ? std::string(" (this array is empty, longer than 16 or holds "
+                                                 "something other than numbers)")
+                                   : ", not " + std::string(typeName(n))));
+        return std::nullopt;
+    }
+    if (width && static_cast<int>(v.size()) != width) {
+        error(n, what + " must be " + widthText(width) + ", not " +
+                     std::to_string(v.size()) + " number" + (v.size() == 1 ? "" : "s"));
+        return std::nullopt;
+    }
+    if (!n.is_array()) return Param(v[0]);
+    return Param(std::move(v));
+}
+
+std::optional<Param> Loader::keyframes(const toml::table& t, const std::string& what, int width) {
+    checkKeys(t, {"keys", "interp"}, "the keyframed curve of " + what);
+    KeyInterp interp = KeyInterp::Linear;
+    bool ok = true;
+    if (const toml::node* i = t.get("interp")) {
+        std::string name;
+        if (!string(*i, what + ": interp", name)) {
+            ok = false;
+        } else if (name == "linear") {
+            interp = KeyInterp::Linear;
+        } else if (name == "smooth") {
+            interp = KeyInterp::Smooth;
+        } else if (name == "step") {
+            interp = KeyInterp::Step;
+        } else {
+            SceneError& e = error(*i, "unknown interpolation '" + name + "' for " + what +
+                                          " (use \"linear\", \"smooth\" or \"step\")");
+            std::string hint = didYouMean(name, {"linear", "smooth", "step"});
+            if (!hint.empty()) e.notes.push_back(hint);
+            ok = false;
+        }
+    }
+    const toml::node* keysNode = t.get("keys");
+    if (!keysNode) {
+        error(t, what + ": a keyframed curve needs keys = [[t0, v0], [t1, v1], ...]");
+        return std::nullopt;
+    }
+    const toml::array* keys = keysNode->as_array();
+    if (!keys || keys->empty()) {
+        error(*keysNode, what + ": keys must be a non-empty array of [time, value] pairs");
+        return std::nullopt;
+    }
+    struct Key {
+        double time;
+        std::vector<double> value;
+        const toml::node* node;
+    };
+    std::vector<Key> list;
+    int keyWidth = width;
+    for (const toml::node& k : *keys) {
+        const toml::array* pair = k.as_array();
+        double time = 0.0;
+        std::vector<double> value;
+        if (!pair || pair->size() != 2 || !isNumber(*pair->get(0))) {
+            error(k, what + ": each key must be [time, value] (time in seconds)");
+            ok = false;
+            continue;
+        }
+        if (!number(*pair->get(0), what + ": a key's time", time)) {
+            ok = false;
+            continue;
+        }
+        if (!vectorValue(*pair->get(1), value)) {
+            error(*pair->get(1), what + ": a key's value must be " +
+                                     (keyWidth ? widthText(keyWidth) : std::string("a number or a vector")));
+            ok = false;
+            continue;
+        }
+        if (keyWidth == 0) keyWidth = static_cast<int>(value.size());
+        if (static_cast<int>(value.size()) != keyWidth) {
+            error(*pair->get(1), what + ": a key's value must be " + widthText(keyWidth) +
+                                     " like the " + (width ? "parameter" : "first key") + ", not " +
+                                     std::to_string(value.size()) + " number" +
+                                     (value.size() == 1 ? "" : "s"));
+            ok = false;
+            continue;
+        }
+        list.push_back({time, std::move(value), &k});
+    }
+    std::stable_sort(list.begin(), list.end(),
+                     [](const Key& a, const Key& b) { return a.time < b.time; });
+    for (size_t i = 1; i < list.size(); ++i) {
+        if (list[i].time == list[i - 1].time) {
+            error(*list[i].node, what + ": two keys at time " + formatNumber(list[i].time) +
+                                     " (each key needs its own time)");
+            ok = false;
+        }
+    }
+    if (!ok) return std::nullopt;
+    std::vector<double> times;
+    std::vector<std::vector<double>> values;
+    for (Key& k : list) {
+        times.push_back(k.time);
+        values.push_back(std::move(k.value));
+    }
+    return Param::keyed(std::move(times), std::move(values), interp);
+}
+
+// Where a string's text starts in the scene when the TOML holds it verbatim (literal strings,
+// or basic strings without escapes); line = 0 otherwise.
+void Loader::verbatimPosition(const toml::node& n, const std::string& value, int& line,
+                              int& col) const {
+    line = col = 0;
+    const toml::source_region& r = n.source();
+    if (r.path && r.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) return;
+    size_t at = offsetOf(r.begin);
+    if (at == std::string::npos || at >= mText.size()) return;
+    const char q = mText[at];
+    if (q != '"' && q != '\'') return;
+    const bool multi = mText.compare(at, 3, std::string(3, q)) == 0;
+    at += multi ? 3 : 1;
+    if (multi && at < mText.size() && mText[at] == '\n') ++at;
+    else if (multi && mText.compare(at, 2, "\r\n") == 0) at += 2;
+    if (mText.compare(at, value.size(), value) != 0) return;
+    // The value must be followed by its closing quote (else it held an escape).
+    if (mText.compare(at + value.size(), 1, std::string(1, q)) != 0) return;
+    const size_t lineIndex =
+        static_cast<size_t>(std::upper_bound(mLineStarts.begin(), mLineStarts.end(), at) -
+                            mLineStarts.begin() - 1);
+    line = static_cast<int>(lineIndex + 1);
+    col = static_cast<int>(at - mLineStarts[lineIndex] + 1);
+}
+
+// ---- Sections ---------------------------------------------------------------------------------
+
+void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
+    checkKeys(t, {"fps", "frames", "substeps", "gravity", "air_density"}, "[scene]");
+    if (const toml::node* n = t.get("fps")) {
+        double v = 0.0;
+        if (number(*n, "scene.fps", v)) {
+            if (v > 0.0)
+                s.fps = v;
+            else
+                error(*n, "scene.fps must be positive");
+        }
+    }
+    if (const toml::node* n = t.get("frames")) {
+        const toml::array* a = n->as_array();
+        long long first = 0, last = 0;
+        if (!a || a->size() != 2) {
+            error(*n, "scene.frames must be [first, last], e.g. [1, 48]");
+        } else if (integer(*a->get(0), "scene.frames' first frame", first) &&
+                   integer(*a->get(1), "scene.frames' last frame", last)) {
+            if (last < first)
+                error(*n, "scene.frames: the last frame (" + std::to_string(last) +
+                              ") comes before the first (" + std::to_string(first) + ")");
+            else if (std::llabs(first) > 100000000 || std::llabs(last) > 100000000)
+                error(*n, "scene.frames: frame numbers must stay within +/-100000000");
+            else {
+                s.frameStart = static_cast<int>(first);
+                s.frameEnd = static_cast<int>(last);
+            }
+        }
+    }
+    if (const toml::node* n = t.get("substeps")) {
+        long long v = 0;
+        if (integer(*n, "scene.substeps", v)) {
+            if (v >= 1 && v <= 10000)
+                s.substeps = static_cast<int>(v);
+            else
+                error(*n, "scene.substeps must be between 1 and 10000");
+        }
+    }
+    if (const toml::node* n = t.get("gravity")) {
+        std::vector<double> g;
+        if (!n->is_array() || !vectorValue(*n, g) || g.size() != 3)
+            error(*n, "scene.gravity must be a vector of 3 numbers [x, y, z] (m/s^2)");
+        else
+            s.gravity = g;
+    }
+    if (const toml::node* n = t.get("air_density")) {
+        double v = 0.0;
+        if (number(*n, "scene.air_density", v)) {
+            if (v >= 0.0)
+                s.airDensity = v;
+            else
+                error(*n, "scene.air_density must not be negative (kg/m^3)");
+        }
+    }
+}
+
+void Loader::loadWindicator(const toml::table& t, Windicator& w) {
+    checkKeys(t, {"direction", "speed"}, "[windicator]");
+    if (const toml::node* n = t.get("direction")) {
+        if (std::optional<Param> p = param(*n, "windicator.direction", 3)) {
+            // Every value (constant or key) must have a direction.
+            bool zero = false;
+            if (p->isKeyed()) {
+                for (const std::vector<double>& v : p->values())
+                    zero = zero || (v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0);
+            } else {
+                const std::vector<double> v = p->at(0.0);
+                zero = v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0;
+            }
+            if (zero)
+                error(*n, "windicator.direction must not be the zero vector");
+            else
+                w.direction = std::move(*p);
+        }
+    }
+    if (const toml::node* n = t.get("speed")) {
+        if (std::optional<Param> p = param(*n, "windicator.speed", 1)) w.speed = std::move(*p);
+    }
+}
+
+void Loader::loadGust(const toml::table& t, size_t index, Gust& g) {
+    checkKeys(t, {"name", "start", "attack", "hold", "decay", "strength", "travel_speed"},
+              "[[gust]]");
+    const std::string label = "gust " + std::to_string(index);
+    if (const toml::node* n = t.get("name")) string(*n, "gust.name", g.name);
+    const std::string what = g.name.empty() ? label : "gust '" + g.name + "'";
+    if (const toml::node* n = t.get("start")) number(*n, what + ": start", g.start);
+    struct Duration {
+        const char* key;
+        double* value;
+    };
+    for (Duration d : {Duration{"attack", &g.attack}, Duration{"hold", &g.hold},
+                       Duration{"decay", &g.decay}}) {
+        const toml::node* n = t.get(d.key);
+        double v = 0.0;
+        if (!n || !number(*n, what + ": " + d.key, v)) continue;
+        if (v < 0.0)
+            error(*n, what + ": " + d.key + " must not be negative (seconds)");
+        else
+            *d.value = v;
+    }
+    if (const toml::node* n = t.get("strength")) {
+        if (std::optional<Param> p = param(*n, what + ": strength", 1)) g.strength = std::move(*p);
+    }
+    if (const toml::node* n = t.get("travel_speed")) {
+        double v = 0.0;
+        if (number(*n, what + ": travel_speed", v)) {
+            if (v > 0.0)
+                g.travelSpeed = v;
+            else
+                error(*n, what + ": travel_speed must be positive (m/s)");
+        }
+    }
+}
+
+void Loader::loadField(const toml::table& t, size_t index, const std::string& baseDir,
+                       FieldEntry& f) {
+    checkKeys(t, {"name", "expr", "source", "preset", "params", "scale", "mask"}, "[[field]]");
+    f.name = "field" + std::to_string(index);
+    if (const toml::node* n = t.get("name")) {
+        std::string name;
+        if (string(*n, "field.name", name)) {
+            if (name.empty() || name.find('.') != std::string::npos)
+                error(*n, "a field's name must be non-empty and without dots (--set uses "
+                          "field.NAME.KEY)");
+            else
+                f.name = name;
+        }
+    }
+    const std::string what = "field '" + f.name + "'";
+    const toml::node* expr = t.get("expr");
+    const toml::node* source = t.get("source");
+    const toml::node* preset = t.get("preset");
+    const int given = (expr ? 1 : 0) + (source ? 1 : 0) + (preset ? 1 : 0);
+    if (given == 0) {
+        error(t, what + " needs its expression: expr = \"file.se\" (relative to the scene), "
+                        "source = \"...\" (inline) or preset = \"wind\"");
+    } else if (given > 1) {
+        const toml::node* second = preset ? preset : source;
+        error(*second, what + ": give only one of expr, source and preset");
+    } else if (expr) {
+        std::string path;
+        if (string(*expr, what + ": expr", path)) {
+            if (path.empty()) {
+                error(*expr, what + ": expr must name a file");
+            } else {
+                std::filesystem::path p(path);
+                f.exprPath = p.is_absolute() || baseDir.empty()
+                                 ? path
+                                 : (std::filesystem::path(baseDir) / p).lexically_normal().string();
+            }
+        }
+    } else if (source) {
+        if (string(*source, what + ": source", f.source))
+            verbatimPosition(*source, f.source, f.sourceLine, f.sourceCol);
+    } else if (preset) {
+        std::string name;
+        if (string(*preset, what + ": preset", name)) {
+            if (findPreset(name)) {
+                f.preset = name;
+            } else {
+                SceneError& e = error(*preset, "unknown preset '" + name + "'");
+                std::vector<std::string> names;
+                for (const Preset& p : presets()) names.emplace_back(p.name);
+                std::string hint = didYouMean(name, names);
+                if (!hint.empty()) e.notes.push_back(hint);
+                e.notes.push_back("presets: " + presetNames());
+            }
+        }
+    }
+    if (const toml::node* n = t.get("params")) {
+        const toml::table* params = n->as_table();
+        if (!params) {
+            error(*n, what + ": params must be a table, e.g. params = { speed = 8 }");
+        } else {
+            for (auto&& [key, value] : *params) {
+                const std::string name(key.str());
+                if (std::optional<Param> p = param(value, what + ": parameter '" + name + "'", 0))
+                    f.params[name] = std::move(*p);
+            }
+        }
+    }
+    if (const toml::node* n = t.get("scale")) {
+        if (std::optional<Param> p = param(*n, what + ": scale", 1)) f.scale = std::move(*p);
+    }
+    if (const toml::node* n = t.get("mask")) {
+        if (string(*n, what + ": mask", f.mask)) {
+            if (trim(f.mask).empty())
+                error(*n, what + ": mask must be an expression, e.g. mask = \"smoothstep($P[1], 0, 2)\"");
+            else
+                verbatimPosition(*n, f.mask, f.maskLine, f.maskCol);
+        }
+    }
+}
+
+// Overrides must name parameters the expression declares, with a fitting width.
+void Loader::checkParams(const toml::table& params, const FieldEntry& f, const Scene& scene,
+                         const toml::node* sourceNode) {
+    lang::SourceFile source;
+    std::string problem;
+    if (!fieldSource(scene, f, source, problem)) {
+        if (sourceNode) error(*sourceNode, "field '" + f.name + "': " + problem).io = true;
+        return;
+    }
+    const std::vector<ParameterDecl> decls = findParameters(source);
+    std::vector<std::string> names;
+    for (const ParameterDecl& d : decls) names.push_back(d.name);
+    const std::string of = f.preset.empty() ? (f.exprPath.empty() ? "its inline source" : f.exprPath)
+                                            : "the " + f.preset + " preset";
+    for (auto&& [key, value] : params) {
+        const std::string name(key.str());
+        auto decl = std::find_if(decls.begin(), decls.end(),
+                                 [&](const ParameterDecl& d) { return d.name == name; });
+        if (decl == decls.end()) {
+            SceneError& e = error(key.source().begin.line ? key.source() : value.source(),
+                                  "'" + name + "' is not a parameter of " + of);
+            std::string hint = didYouMean(name, names);
+            if (!hint.empty()) e.notes.push_back(hint);
+            e.notes.push_back(names.empty() ? "it declares no parameters (a top-level `$name = "
+                                              "value;  # min, max` statement declares one)"
+                                            : "its parameters: " + joinNames(names));
+            continue;
+        }
+        auto p = f.params.find(name);
+        if (p == f.params.end()) continue; // already reported
+        if (scene.windicator && f.preset == "wind" && (name == "speed" || name == "direction")) {
+            // The preset reads getVar("windSpeed", $speed): the windicator would win silently.
+            SceneError& e = error(key.source().begin.line ? key.source() : value.source(),
+                                  "with a [windicator], the wind preset's '" + name +
+                                      "' comes from it: set windicator." + name + " instead");
+            e.notes.push_back("or copy the preset into a file (expr = \"my_wind.se\") to make it "
+                              "ignore the windicator");
+            continue;
+        }
+        const int want = static_cast<int>(decl->defaultValue.size());
+        if (p->second.width() != want && p->second.width() != 1)
+            error(value, "parameter '" + name + "' of " + of + " is " + widthText(want) +
+                             ", not " + std::to_string(p->second.width()) + " numbers");
+    }
+}
+
+void Loader::load(const toml::table& root, Scene& out) {
+    const std::vector<std::string> sections = {"scene", "windicator", "gust", "field"};
+    std::vector<std::string> known = sections;
+    known.insert(known.end(), mOptions.foreignSections.begin(), mOptions.foreignSections.end());
+    for (auto&& [key, node] : root) {
+        const std::string name(key.str());
+        if (std::find(known.begin(), known.end(), name) != known.end()) continue;
+        SceneError& e = error(key.source().begin.line ? key.source() : node.source(),
+                              "unknown scene section or key '" + name + "'");
+        std::string hint = didYouMean(name, known);
+        if (!hint.empty()) e.notes.push_back(hint);
+        e.notes.push_back("a scene has [scene], [windicator], [[gust]] and [[field]] sections" +
+                          std::string(mOptions.foreignSections.empty()
+                                          ? ""
+                                          : ", and " + joinNames(mOptions.foreignSections) +
+                                                " for the solver"));
+    }
+    if (const toml::node* n = root.get("scene")) {
+        if (const toml::table* t = n->as_table())
+            loadSettings(*t, out.settings);
+        else
+            error(*n, "scene must be a table: write [scene]");
+    }
+    if (const toml::node* n = root.get("windicator")) {
+        if (const toml::table* t = n->as_table()) {
+            out.windicator = Windicator{};
+            loadWindicator(*t, *out.windicator);
+        } else {
+            error(*n, "windicator must be a table: write [windicator]");
+        }
+    }
+    // [[gust]] and [[field]]: arrays of tables.
+    auto tables = [&](const char* section) -> std::vector<const toml::table*> {
+        std::vector<const toml::table*> list;
+        const toml::node* n = root.get(section);
+        if (!n) return list;
+        const toml::array* a = n->as_array();
+        if (!a) {
+            error(*n, std::string(section) + " must be an array of tables: write [[" + section +
+                          "]] (once per " + section + ")");
+            return list;
+        }
+        for (const toml::node& e : *a) {
+            if (const toml::table* t = e.as_table())
+                list.push_back(t);
+            else
+                error(e, std::string("each ") + section + " must be a table, not " + typeName(e));
+        }
+        return list;
+    };
+    std::set<std::string> gustNames;
+    const std::vector<const toml::table*> gustTables = tables("gust");
+    for (size_t i = 0; i < gustTables.size(); ++i) {
+        Gust g;
+        loadGust(*gustTables[i], i, g);
+        if (!g.name.empty() && !gustNames.insert(g.name).second)
+            error(*gustTables[i]->get("name"), "two gusts are named '" + g.name + "'");
+        out.gusts.push_back(std::move(g));
+    }
+    std::set<std::string> fieldNames;
+    const std::vector<const toml::table*> fieldTables = tables("field");
+    out.fields.reserve(fieldTables.size());
+    for (size_t i = 0; i < fieldTables.size(); ++i) {
+        const size_t errorsBefore = mErrors.size();
+        FieldEntry f;
+        loadField(*fieldTables[i], i, out.baseDir, f);
+        if (!fieldNames.insert(f.name).second) {
+            const toml::node* n = fieldTables[i]->get("name");
+            error(n ? static_cast<const toml::node&>(*n) : *fieldTables[i],
+                  "two fields are named '" + f.name + "'");
+        }
+        // Parameter names can be checked once the expression is known.
+        const toml::node* params = fieldTables[i]->get("params");
+        if (mErrors.size() == errorsBefore && params && params->is_table()) {
+            const toml::node* sourceNode = fieldTables[i]->get("expr");
+            checkParams(*params->as_table(), f, out, sourceNode);
+        } else if (mErrors.size() == errorsBefore && !f.exprPath.empty()) {
+            // Still report an unreadable expression file at its key.
+            lang::SourceFile source;
+            std::string problem;
+            if (!fieldSource(out, f, source, problem))
+                error(*fieldTables[i]->get("expr"), "field '" + f.name + "': " + problem).io = true;
+        }
+        out.fields.push_back(std::move(f));
+    }
+}
+
+} // namespace
+
+bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& errors,
+               const SceneLoadOptions& options) {
+    const size_t errorsBefore = errors.size();
+    out = Scene{};
+    out.path = path;
+    out.baseDir = std::filesystem::path(path).parent_path().string();
+
+    std::string text;
+    {
+        std::error_code ec;
+        errno = 0;
+        std::ifstream in;
+        if (!std::filesystem::is_directory(path, ec)) in.open(path, std::ios::binary);
+        if (!in) {
+            SceneError e;
+            e.file = path;
+            e.message = std::string("cannot read the scene: ") + std::strerror(errno ? errno : EISDIR);
+            e.io = true;
+            errors.push_back(std::move(e));
+            return false;
+        }
+        text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+
+    Loader loader(path, text, errors, options);
+    toml::table root;
+    try {
+        root = toml::parse(text, path);
+    } catch (const toml::parse_error& e) {
+        SceneError& se = loader.error(e.source(), std::string(e.description()));
+        se.file = path;
+        return false;
+    }
+    loader.applySets(root);
+    loader.load(root, out);
+    // In file order (--set problems, which have no line, first), as a compiler reports.
+    std::stable_sort(errors.begin() + static_cast<std::ptrdiff_t>(errorsBefore), errors.end(),
+                     [](const SceneError& a, const SceneError& b) {
+                         return a.line != b.line ? a.line < b.line : a.col < b.col;
+                     });
+    return errors.size() == errorsBefore;
+}
+
+} // namespace gale::fields

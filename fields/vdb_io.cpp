@@ -1,0 +1,224 @@
+// OpenVDB reading and writing of velocity grids — the only file that includes OpenVDB headers
+// (they are slow to compile); everything else goes through fields/vdb_io.h.
+#include "fields/vdb_io.h"
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+#include <openvdb/tools/Prune.h>
+#include <openvdb/tree/LeafManager.h>
+
+#include <cmath>
+#include <exception>
+
+namespace gale::fields {
+
+namespace {
+
+void initOpenVdb() {
+    static const bool done = [] {
+        openvdb::initialize();
+        return true;
+    }();
+    (void)done;
+}
+
+IoError makeError(IoError::Kind kind, const std::string& file, const std::string& message) {
+    IoError e;
+    e.kind = kind;
+    e.file = file;
+    e.message = message;
+    return e;
+}
+
+std::string vectorTypeName(openvdb::VecType t) {
+    switch (t) {
+    case openvdb::VEC_INVARIANT:
+        return "invariant";
+    case openvdb::VEC_COVARIANT:
+        return "covariant";
+    case openvdb::VEC_COVARIANT_NORMALIZE:
+        return "covariant-normalize";
+    case openvdb::VEC_CONTRAVARIANT_RELATIVE:
+        return "contravariant-relative";
+    case openvdb::VEC_CONTRAVARIANT_ABSOLUTE:
+        return "contravariant-absolute";
+    }
+    return "unknown";
+}
+
+std::string gridClassName(openvdb::GridClass c) {
+    switch (c) {
+    case openvdb::GRID_LEVEL_SET:
+        return "level set";
+    case openvdb::GRID_FOG_VOLUME:
+        return "fog volume";
+    case openvdb::GRID_STAGGERED:
+        return "staggered";
+    default:
+        return "unknown";
+    }
+}
+
+// Index (0,0,0) at the centre of cell (0,0,0); a scale by the voxel size per axis.
+openvdb::math::Transform::Ptr cellCentredTransform(const GridSpec& grid) {
+    const openvdb::Vec3d voxel(grid.voxel[0], grid.voxel[1], grid.voxel[2]);
+    const openvdb::Vec3d first(grid.origin[0] + 0.5 * grid.voxel[0],
+                               grid.origin[1] + 0.5 * grid.voxel[1],
+                               grid.origin[2] + 0.5 * grid.voxel[2]);
+    openvdb::math::Transform::Ptr xf;
+    if (grid.cubicVoxels()) {
+        xf = openvdb::math::Transform::createLinearTransform(grid.voxel[0]);
+    } else {
+        openvdb::Mat4d m = openvdb::Mat4d::identity();
+        m.setToScale(voxel);
+        xf = openvdb::math::Transform::createLinearTransform(m);
+    }
+    xf->postTranslate(first);
+    return xf;
+}
+
+} // namespace
+
+IoError writeVdbVelocity(const std::string& path, const GridSpec& spec,
+                         const std::vector<float>& values, const VdbWriteOptions& options) {
+    if (values.size() != 3 * spec.cellCount())
+        return makeError(IoError::Data, path,
+                         "the grid has " + std::to_string(spec.cellCount()) + " cells but " +
+                             std::to_string(values.size()) + " values were given (3 per cell)");
+    initOpenVdb();
+    openvdb::Vec3SGrid::Ptr grid;
+    try {
+        grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+        grid->setName(options.gridName);
+        grid->setTransform(cellCentredTransform(spec));
+        grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+        grid->setGridClass(openvdb::GRID_UNKNOWN);
+        grid->setSaveFloatAsHalf(false);
+        for (const auto& [key, text] : options.metadata)
+            grid->insertMeta(key, openvdb::StringMetadata(text));
+        for (const auto& [key, v] : options.floatMetadata)
+            grid->insertMeta(key, openvdb::DoubleMetadata(v));
+
+        // Every cell active, then the values leaf by leaf (in parallel), then runs of equal
+        // values folded into tiles.
+        const int nx = spec.res[0], ny = spec.res[1], nz = spec.res[2];
+        const openvdb::CoordBBox box(openvdb::Coord(0), openvdb::Coord(nx - 1, ny - 1, nz - 1));
+        openvdb::Vec3STree& tree = grid->tree();
+        tree.denseFill(box, openvdb::Vec3s(0.0f), /*active=*/true);
+        openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(tree);
+        leaves.foreach ([&](openvdb::Vec3STree::LeafNodeType& leaf, size_t) {
+            for (auto it = leaf.beginValueOn(); it; ++it) {
+                const openvdb::Coord c = it.getCoord();
+                const float* v = values.data() + 3 * spec.index(c.x(), c.y(), c.z());
+                it.setValue(openvdb::Vec3s(v[0], v[1], v[2]));
+            }
+        });
+        openvdb::tools::prune(tree);
+    } catch (const std::exception& e) {
+        return makeError(IoError::Data, path,
+                         std::string("cannot build the VDB grid: ") + e.what());
+    }
+
+    return writeFileAtomic(path, [&](const std::string& tmp) -> IoError {
+        try {
+            openvdb::GridPtrVec grids{grid};
+            openvdb::MetaMap fileMeta;
+            fileMeta.insertMeta("creator", openvdb::StringMetadata("gale"));
+            openvdb::io::File file(tmp);
+            file.write(grids, fileMeta);
+            file.close();
+        } catch (const std::exception& e) {
+            return makeError(IoError::Io, path, std::string("cannot write: ") + e.what());
+        }
+        return {};
+    });
+}
+
+IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out) {
+    initOpenVdb();
+    openvdb::GridPtrVecPtr grids;
+    try {
+        openvdb::io::File file(path);
+        file.open();
+        grids = file.getGrids();
+        file.close();
+    } catch (const std::exception& e) {
+        return makeError(IoError::Io, path, std::string("cannot read: ") + e.what());
+    }
+    openvdb::Vec3SGrid::Ptr grid;
+    for (const openvdb::GridBase::Ptr& g : *grids) {
+        if (!gridName.empty() && g->getName() != gridName) continue;
+        grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+        if (!grid && !gridName.empty())
+            return makeError(IoError::Data, path,
+                             "grid '" + gridName + "' holds " + g->valueType() +
+                                 " values, not vec3s");
+        if (grid) break;
+    }
+    if (!grid)
+        return makeError(IoError::Data, path,
+                         gridName.empty() ? std::string("the file has no vec3s grid")
+                                          : "the file has no grid named '" + gridName + "'");
+
+    const openvdb::math::Transform& xf = grid->transform();
+    if (!xf.isLinear())
+        return makeError(IoError::Data, path,
+                         "grid '" + grid->getName() + "' has a non-linear (frustum) transform");
+    const openvdb::Vec3d o = xf.indexToWorld(openvdb::Vec3d(0.0));
+    openvdb::Vec3d voxel;
+    for (int a = 0; a < 3; ++a) {
+        openvdb::Vec3d unit(0.0);
+        unit[a] = 1.0;
+        const openvdb::Vec3d d = xf.indexToWorld(unit) - o;
+        for (int b = 0; b < 3; ++b)
+            if (b != a && std::abs(d[b]) > 1e-12 * std::abs(d[a]))
+                return makeError(IoError::Data, path,
+                                 "grid '" + grid->getName() +
+                                     "' has a rotated or sheared transform");
+        if (!(d[a] > 0))
+            return makeError(IoError::Data, path,
+                             "grid '" + grid->getName() + "' has a mirrored transform");
+        voxel[a] = d[a];
+    }
+    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    if (box.empty())
+        return makeError(IoError::Data, path,
+                         "grid '" + grid->getName() + "' has no active voxels");
+    const openvdb::Coord dim = box.dim();
+    const double cells = static_cast<double>(dim.x()) * dim.y() * dim.z();
+    if (cells > static_cast<double>(kMaxGridCells))
+        return makeError(IoError::Data, path,
+                         "grid '" + grid->getName() + "' is too large to read densely");
+
+    VdbVelocity r;
+    r.gridName = grid->getName();
+    r.vectorType = vectorTypeName(grid->getVectorType());
+    r.gridClass = gridClassName(grid->getGridClass());
+    r.uniformScale = xf.hasUniformScale();
+    r.indexMin = {box.min().x(), box.min().y(), box.min().z()};
+    const openvdb::Vec3d corner =
+        xf.indexToWorld(openvdb::Vec3d(box.min().x(), box.min().y(), box.min().z()) - 0.5);
+    for (int a = 0; a < 3; ++a) {
+        r.grid.origin[static_cast<size_t>(a)] = corner[a];
+        r.grid.voxel[static_cast<size_t>(a)] = voxel[a];
+        r.grid.res[static_cast<size_t>(a)] = dim[a];
+    }
+    for (auto it = grid->beginMeta(); it != grid->endMeta(); ++it)
+        r.metadata[it->first] = it->second ? it->second->str() : std::string();
+    try {
+        // LayoutZYX: z fastest, x slowest — the same order as sampleGrid.
+        openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutZYX> dense(box);
+        openvdb::tools::copyToDense(*grid, dense);
+        r.values.resize(3 * r.grid.cellCount());
+        const openvdb::Vec3s* src = dense.data();
+        for (size_t i = 0; i < r.grid.cellCount(); ++i)
+            for (int c = 0; c < 3; ++c) r.values[3 * i + static_cast<size_t>(c)] = src[i][c];
+    } catch (const std::exception& e) {
+        return makeError(IoError::Data, path, std::string("cannot read the voxels: ") + e.what());
+    }
+    out = std::move(r);
+    return {};
+}
+
+} // namespace gale::fields

@@ -1,0 +1,363 @@
+// The linearised backward-Euler substep shared by cloth and hair.
+//
+// Baraff & Witkin, "Large Steps in Cloth Simulation", SIGGRAPH 1998, eq. (16)–(17):
+//   (M + h D + h² K) Δv = h (f₀ − h K v₀),   v₁ = v₀ + Δv,   x₁ = x₀ + h v₁
+// with K = −∂f/∂x and D = −∂f/∂v positive semi-definite, so the matrix is SPD. Pins and
+// contacts enter through the constraint filter (linear.h). Optional extra Newton iterations
+// solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
+// same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
+#include "solver/body.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace gale::solver {
+
+namespace {
+// A vertex this close to a collider's offset surface (m) counts as touching it: rounding
+// after a projection must not switch the contact off.
+constexpr double kContactSlop = 1e-7;
+} // namespace
+
+bool PaintedParam::alwaysZero() const {
+    if (!value.isKeyed()) return value.scalarAt(0.0) == 0.0;
+    for (const auto& v : value.values())
+        if (!v.empty() && v[0] != 0.0) return false;
+    return true;
+}
+
+const char* troubleName(Trouble t) {
+    switch (t) {
+    case Trouble::None: return "none";
+    case Trouble::NonFinite: return "non-finite state";
+    case Trouble::SolverNotConverged: return "linear solver did not converge";
+    case Trouble::OverStretch: return "over-stretch";
+    case Trouble::VelocityJump: return "velocity jump";
+    }
+    return "?";
+}
+
+Body::Body(std::string name, const VecX& restPositions)
+    : mName(std::move(name)), mX(restPositions), mV(VecX::Zero(restPositions.size())),
+      mMass(VecX::Zero(restPositions.size() / 3)), mRest(restPositions) {}
+
+void Body::finishSetup(const std::vector<std::array<int, 2>>& edges) {
+    const size_t n = vertexCount();
+    mHeld.assign(n, 0);
+    for (size_t i = 0; i < n; ++i)
+        if (!(mMass[i] > 0.0) || !std::isfinite(mMass[i])) {
+            mHeld[i] = 1; // in no element of positive size: nothing moves it, keep it in place
+            mMass[i] = 1.0;
+        }
+    std::vector<std::pair<int, int>> pairs;
+    couplings(pairs);
+    mA.build(static_cast<int>(n), pairs);
+    mEdges = edges;
+    mEdgeRest.resize(edges.size());
+    for (size_t e = 0; e < edges.size(); ++e)
+        mEdgeRest[e] = (vec3At(mRest.data(), edges[e][1]) - vec3At(mRest.data(), edges[e][0])).norm();
+    mContactImpulse.assign(n, 0.0);
+    mContactCollider.assign(n, -1);
+}
+
+void Body::addPins(const PinSet& pins) {
+    const int set = static_cast<int>(mPinSets.size());
+    mPinSets.push_back(pins);
+    for (int v : pins.vertices) {
+        if (v < 0 || static_cast<size_t>(v) >= vertexCount()) continue;
+        if (std::find(mPinned.begin(), mPinned.end(), v) != mPinned.end()) continue;
+        mPinned.push_back(v);
+        mPinSet.push_back(set);
+        const Vec3 p = vec3At(mX.data(), v);
+        mAnchor.conservativeResize(mAnchor.size() + 3);
+        mAnchor.tail<3>() = p;
+    }
+}
+
+Vec3 Body::pinTarget(size_t k, double t) const {
+    const std::vector<double> d = mPinSets[mPinSet[k]].translate.at(t);
+    Vec3 off = d.size() >= 3 ? Vec3(d[0], d[1], d[2]) : Vec3::Zero();
+    return mAnchor.segment<3>(3 * k) + off;
+}
+
+void Body::restore(const Snapshot& s) {
+    mX = s.x;
+    mV = s.v;
+    mDvGuess = s.dvGuess;
+    mHGuess = s.hGuess;
+}
+
+double Body::kineticEnergy() const {
+    double e = 0.0;
+    for (size_t i = 0; i < vertexCount(); ++i)
+        if (!mHeld[i]) e += 0.5 * mMass[i] * vec3At(mV.data(), i).squaredNorm();
+    return e;
+}
+
+double Body::potentialEnergy(const Vec3& gravity) const {
+    double e = 0.0;
+    for (size_t i = 0; i < vertexCount(); ++i)
+        if (!mHeld[i]) e -= mMass[i] * gravity.dot(vec3At(mX.data(), i));
+    return e;
+}
+
+double Body::elasticEnergy(double t) {
+    VecX f = VecX::Zero(mX.size());
+    ForceInput in;
+    in.x = mX.data();
+    in.v = mV.data();
+    in.t = t;
+    ForceOutput out;
+    out.f = &f;
+    addForces(in, out);
+    return out.elasticEnergy;
+}
+
+double Body::maxEdgeStretch() const {
+    double m = 0.0;
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        if (!(mEdgeRest[e] > 0.0)) continue;
+        const double len =
+            (vec3At(mX.data(), mEdges[e][1]) - vec3At(mX.data(), mEdges[e][0])).norm();
+        m = std::max(m, len / mEdgeRest[e]);
+    }
+    return m;
+}
+
+void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity) {
+    const size_t n = vertexCount();
+    mA.setZero();
+    mF.setZero(3 * n);
+    mKv.setZero(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        mA.addDiagonal(mA.diagonalSlot(static_cast<int>(i)), mMass[i]);
+        if (!mHeld[i]) mF.segment<3>(3 * i) += mMass[i] * gravity;
+    }
+    out.f = &mF;
+    out.kv = &mKv;
+    out.A = &mA;
+    addForces(in, out);
+}
+
+void Body::contactConstraints(const Environment& env, double t, double h) {
+    std::fill(mContactImpulse.begin(), mContactImpulse.end(), 0.0);
+    std::fill(mContactCollider.begin(), mContactCollider.end(), -1);
+    if (!env.colliders || env.colliders->empty()) return;
+    const size_t n = vertexCount();
+    for (const Collider& c : *env.colliders) {
+        const ColliderPose pose = colliderPose(c, t);
+        for (size_t i = 0; i < n; ++i) {
+            if (mConstraints.kind[i] == 1) continue; // pinned or held
+            const Vec3 x = vec3At(mX.data(), i);
+            const ContactPoint cp = queryCollider(pose, x);
+            if (!(cp.distance < c.thickness + kContactSlop)) continue;
+            // Predicted normal speed relative to the surface without the constraint: keep
+            // the vertex on the surface only if it would move in (no adhesion).
+            const Vec3 v0 = vec3At(mV.data(), i);
+            const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - cp.velocity;
+            const double un = pred.dot(cp.normal);
+            if (!(un < 0.0)) continue;
+            mConstraints.kind[i] = 2;
+            vec3At(mConstraints.normal.data(), i) = cp.normal;
+            vec3At(mConstraints.z.data(), i) = cp.normal * (cp.velocity - v0).dot(cp.normal);
+            mContactImpulse[i] = -un;
+            mContactCollider[i] = static_cast<int>(&c - env.colliders->data());
+        }
+    }
+}
+
+int Body::resolveContacts(const Environment& env, double t1, double h) {
+    if (!env.colliders || env.colliders->empty()) return 0;
+    const size_t n = vertexCount();
+    std::vector<uint8_t> touched(n, 0);
+    for (const Collider& c : *env.colliders) {
+        const ColliderPose pose = colliderPose(c, t1);
+        for (size_t i = 0; i < n; ++i) {
+            if (mConstraints.kind[i] == 1) continue;
+            Eigen::Map<Vec3> x(mX.data() + 3 * i);
+            const ContactPoint cp = queryCollider(pose, x);
+            const bool held = mContactCollider[i] == static_cast<int>(&c - env.colliders->data());
+            if (!(cp.distance < c.thickness) && !held) continue;
+            touched[i] = 1;
+            if (cp.distance < c.thickness) x += (c.thickness - cp.distance) * cp.normal;
+            Eigen::Map<Vec3> v(mV.data() + 3 * i);
+            Vec3 rel = v - cp.velocity;
+            double impulse = mContactImpulse[i]; // m/s removed by the constraint in the solve
+            const double vn = rel.dot(cp.normal);
+            if (vn < 0.0) {
+                rel -= vn * cp.normal;
+                impulse += -vn;
+            }
+            // Coulomb friction: the tangential speed drops by at most μ × the normal impulse.
+            const Vec3 vt = rel - rel.dot(cp.normal) * cp.normal;
+            const double vtn = vt.norm();
+            Vec3 slip = Vec3::Zero();
+            if (vtn > 0.0) {
+                const double keep = std::max(0.0, 1.0 - c.friction * impulse / vtn);
+                slip = (1.0 - keep) * vt;
+                rel -= slip;
+            }
+            // The position moved with the velocity before friction: take that part back too,
+            // so that x₁ = x₀ + h v₁ holds for the tangential motion.
+            x -= h * slip;
+            v = cp.velocity + rel;
+            mContactImpulse[i] = 0.0;
+            mContactCollider[i] = -1;
+        }
+    }
+    int count = 0;
+    for (uint8_t u : touched) count += u;
+    return count;
+}
+
+SubstepStatus Body::substep(const Environment& env, double t, double h) {
+    SubstepStatus st;
+    const size_t n = vertexCount();
+    const VecX x0 = mX, v0 = mV;
+    const double stretchBefore = mEdges.empty() ? 0.0 : maxEdgeStretch();
+
+    // 1. Wind at the vertices, once per substep, as one batch.
+    const bool aero = feelsWind();
+    double maxWind = 0.0;
+    if (aero) {
+        mWind.setZero(3 * n);
+        if (env.wind) {
+            fields::SampleTime when;
+            when.time = t;
+            when.fps = env.fps;
+            when.substep = env.substepIndex;
+            when.threads = env.threads;
+            const fields::SampleStatus ss = env.wind->sample(mX.data(), n, when, mWind.data());
+            size_t bad = 0;
+            for (size_t i = 0; i < 3 * n; ++i)
+                if (!std::isfinite(mWind[i])) {
+                    mWind[i] = 0.0;
+                    ++bad;
+                }
+            st.windNonFinite = std::max(ss.nonFinite, bad);
+            if (!ss.ok || st.windNonFinite) {
+                st.windMessage = ss.message.empty()
+                                     ? std::to_string(st.windNonFinite) +
+                                           " wind sample(s) were not finite and were replaced by zero"
+                                     : ss.message;
+                if (st.windNonFinite == 0 && !ss.ok) st.windNonFinite = 1;
+            }
+        }
+        for (size_t i = 0; i < n; ++i) maxWind = std::max(maxWind, vec3At(mWind.data(), i).norm());
+    }
+
+    // 2. Forces, K v and the matrix M + hD + h²K at (x₀, v₀).
+    ForceInput in;
+    in.x = mX.data();
+    in.v = mV.data();
+    in.wind = aero ? mWind.data() : nullptr;
+    in.t = t;
+    in.h = h;
+    in.airDensity = env.airDensity;
+    in.aeroJacobian = mOptions.aeroJacobian;
+    ForceOutput out;
+    assemble(in, out, env.gravity);
+    st.clampedJacobians = out.clamped;
+    mB = h * (mF - h * mKv);
+
+    // 3. Constraints: pins reach their target at t + h; held vertices stay; contacts.
+    mConstraints.reset(n);
+    double pinSpeed = 0.0;
+    for (size_t k = 0; k < mPinned.size(); ++k) {
+        const int i = mPinned[k];
+        mConstraints.kind[i] = 1;
+        const Vec3 vTarget = (pinTarget(k, t + h) - vec3At(x0.data(), i)) / h;
+        vec3At(mConstraints.z.data(), i) = vTarget - vec3At(v0.data(), i);
+        pinSpeed = std::max(pinSpeed, vTarget.norm());
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (mHeld[i]) {
+            mConstraints.kind[i] = 1;
+            vec3At(mConstraints.z.data(), i) = -vec3At(v0.data(), i);
+        }
+    contactConstraints(env, t, h);
+
+    // 4. Solve, warm-started from the previous substep's Δv scaled to this step.
+    if (mOptions.warmStart && mDvGuess.size() == static_cast<long>(3 * n) && mHGuess > 0.0 &&
+        mDvGuess.allFinite())
+        mDv = mDvGuess * (h / mHGuess);
+    else
+        mDv.setZero(3 * n);
+    SolveStatus ls = mSolver.solve(mA, mConstraints, mB, mDv, mOptions.linearSolver,
+                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
+    st.iterations = ls.iterations;
+    st.residual = ls.residual;
+    st.converged = ls.converged && !ls.failed;
+
+    // 5. Optional Newton iterations on the backward-Euler residual.
+    for (int k = 0; k < mOptions.newtonIterations && st.converged; ++k) {
+        mV = v0 + mDv;
+        mX = x0 + h * mV;
+        in.x = mX.data();
+        in.v = mV.data();
+        assemble(in, out, env.gravity);
+        VecX rhs(3 * n);
+        for (size_t i = 0; i < n; ++i)
+            rhs.segment<3>(3 * i) =
+                h * mF.segment<3>(3 * i) - mMass[i] * (mV.segment<3>(3 * i) - v0.segment<3>(3 * i));
+        std::fill(mConstraints.z.begin(), mConstraints.z.end(), 0.0);
+        VecX delta = VecX::Zero(3 * n);
+        SolveStatus ns = mSolver.solve(mA, mConstraints, rhs, delta, mOptions.linearSolver,
+                                       mOptions.cgTolerance, mOptions.cgMaxIterations);
+        st.iterations += ns.iterations;
+        st.residual = std::max(st.residual, ns.residual);
+        st.converged = ns.converged && !ns.failed;
+        mDv += delta;
+    }
+    mDvGuess = mDv;
+    mHGuess = h;
+    mV = v0 + mDv;
+    mX = x0 + h * mV;
+
+    // 6. Colliders: push out, remove approach speed, Coulomb friction.
+    st.contacts = resolveContacts(env, t + h, h);
+
+    // 7. Trouble detection.
+    double maxSpeed = 0.0, maxJump = 0.0, maxSpeed0 = 0.0;
+    bool finite = mX.allFinite() && mV.allFinite();
+    if (finite)
+        for (size_t i = 0; i < n; ++i) {
+            if (mHeld[i]) continue;
+            maxSpeed = std::max(maxSpeed, vec3At(mV.data(), i).norm());
+            maxSpeed0 = std::max(maxSpeed0, vec3At(v0.data(), i).norm());
+            if (mConstraints.kind[i] != 1)
+                maxJump = std::max(maxJump, (vec3At(mV.data(), i) - vec3At(v0.data(), i)).norm());
+        }
+    st.maxSpeed = maxSpeed;
+    st.maxStretch = finite && !mEdges.empty() ? maxEdgeStretch() : 0.0;
+    char buf[200];
+    if (!finite || ls.failed) {
+        st.trouble = Trouble::NonFinite;
+        st.reason = !finite ? "positions or velocities became non-finite"
+                            : "the linear solve produced non-finite values";
+    } else if (!st.converged) {
+        st.trouble = Trouble::SolverNotConverged;
+        std::snprintf(buf, sizeof buf, "residual %.3g after %d iterations (tolerance %.3g)",
+                      st.residual, st.iterations, mOptions.cgTolerance);
+        st.reason = buf;
+    } else if (st.maxStretch > mLimits.overStretch && st.maxStretch > 1.05 * stretchBefore) {
+        st.trouble = Trouble::OverStretch;
+        std::snprintf(buf, sizeof buf, "an edge reached %.3g× its rest length (limit %.3g×)",
+                      st.maxStretch, mLimits.overStretch);
+        st.reason = buf;
+    } else {
+        const double limit =
+            mLimits.velocityJump + 2.0 * (maxWind + maxSpeed0 + pinSpeed + env.gravity.norm() * h);
+        if (maxJump > limit) {
+            st.trouble = Trouble::VelocityJump;
+            std::snprintf(buf, sizeof buf, "a vertex changed speed by %.3g m/s in one substep "
+                                           "(limit %.3g m/s)",
+                          maxJump, limit);
+            st.reason = buf;
+        }
+    }
+    return st;
+}
+
+} // namespace gale::solver

@@ -1,0 +1,182 @@
+// A simulated body (cloth or hair): particle state, lumped masses, pins, and the linearised
+// backward-Euler substep (Baraff & Witkin 1998) shared by every kind of body. Subclasses
+// supply the pattern of coupled vertices and their forces with SPD Jacobians.
+#pragma once
+
+#include "fields/field.h"
+#include "fields/keyframes.h"
+#include "solver/aero.h"
+#include "solver/collider.h"
+#include "solver/linear.h"
+#include "solver/types.h"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+// A scalar that is keyframable (`value`) and optionally painted per vertex (`map`, multiplied).
+struct PaintedParam {
+    fields::Param value{1.0};
+    std::vector<double> map; // per vertex, empty: 1 everywhere
+
+    double at(double t) const { return value.scalarAt(t); }
+    bool painted() const { return !map.empty(); }
+    // True when the value is zero at every key (and the constant): the term can be skipped.
+    bool alwaysZero() const;
+};
+
+// Pinned vertices, held at their initial positions plus a keyframable translation.
+struct PinSet {
+    std::vector<int> vertices;
+    fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
+};
+
+// Numerical settings of a body's substep.
+struct StepOptions {
+    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    LinearSolverKind linearSolver = LinearSolverKind::Pcg;
+    double cgTolerance = 1e-3;  // relative residual of the filtered system
+    int cgMaxIterations = 2000;
+    int newtonIterations = 0;   // extra Newton iterations on the backward-Euler residual
+    bool warmStart = true;      // start CG from the previous substep's Δv
+};
+
+// What a substep sees of the world.
+struct Environment {
+    const fields::Field* wind = nullptr; // summed scene fields (may be null: still air)
+    double airDensity = 1.225;           // kg/m³
+    Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+    const std::vector<Collider>* colliders = nullptr;
+    double fps = 24.0;
+    int threads = 1;
+    int substepIndex = 0;
+};
+
+// Why a substep was rejected (the caller halves the step and retries).
+enum class Trouble { None, NonFinite, SolverNotConverged, OverStretch, VelocityJump };
+const char* troubleName(Trouble t);
+
+struct SubstepStatus {
+    Trouble trouble = Trouble::None;
+    std::string reason;       // human-readable detail of the trouble
+    int iterations = 0;       // linear-solver iterations (all Newton iterations)
+    double residual = 0.0;    // the largest relative residual of those solves
+    bool converged = true;
+    size_t windNonFinite = 0; // wind samples that came back NaN/inf (replaced by zero)
+    std::string windMessage;
+    int clampedJacobians = 0; // paper Jacobian with C_D < C_L, clamped
+    double maxSpeed = 0.0;    // m/s after the step
+    double maxStretch = 0.0;  // largest edge length / rest length after the step
+    int contacts = 0;         // vertices touching a collider after the step
+};
+
+// Limits of the trouble detectors.
+struct TroubleLimits {
+    double overStretch = 3.0;   // edge length / rest length that counts as over-stretched
+    double velocityJump = 50.0; // m/s: a |Δv| larger than this and than 2× the speed scale
+};
+
+// What a body's force routine reads and writes.
+struct ForceInput {
+    const double* x = nullptr;
+    const double* v = nullptr;
+    const double* wind = nullptr; // per vertex, null when the body feels no wind
+    double t = 0.0, h = 0.0;
+    double airDensity = 1.225;
+    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+};
+struct ForceOutput {
+    VecX* f = nullptr;          // forces (N), accumulated
+    VecX* kv = nullptr;         // K v (N/s) with K = −∂f/∂x, accumulated (null: not needed)
+    BlockMatrix* A = nullptr;   // h·D + h²·K accumulated (null: forces only)
+    double elasticEnergy = 0.0; // J
+    int clamped = 0;
+};
+
+class Body {
+public:
+    virtual ~Body() = default;
+    Body(const Body&) = delete;
+    Body& operator=(const Body&) = delete;
+
+    const std::string& name() const { return mName; }
+    size_t vertexCount() const { return mMass.size(); }
+    const VecX& positions() const { return mX; }
+    const VecX& velocities() const { return mV; }
+    const VecX& masses() const { return mMass; } // kg per vertex
+    // Replace state (e.g. a pre-stretched start, or a resumed run). Sizes must match.
+    void setPositions(const VecX& x) { mX = x; }
+    void setVelocities(const VecX& v) { mV = v; }
+    // Overrides lumped masses (kg per vertex; e.g. tests of equal-mass chains).
+    void setMasses(const VecX& m) { mMass = m; }
+    StepOptions& options() { return mOptions; }
+    const StepOptions& options() const { return mOptions; }
+    TroubleLimits& limits() { return mLimits; }
+
+    void addPins(const PinSet& pins);
+    const std::vector<int>& pinnedVertices() const { return mPinned; }
+    // Pin target position of vertex index `k` in pinnedVertices() at time t.
+    Vec3 pinTarget(size_t k, double t) const;
+
+    // One linearised backward-Euler substep from t to t + h. Updates the state even when the
+    // status reports trouble: the caller keeps a snapshot and decides.
+    SubstepStatus substep(const Environment& env, double t, double h);
+
+    // Whether any force of this body reads the wind (aerodynamic coefficients not all zero).
+    virtual bool feelsWind() const = 0;
+    virtual const char* kind() const = 0;
+
+    // The full state a bit-identical continuation needs (positions, velocities, warm start).
+    struct Snapshot {
+        VecX x, v, dvGuess;
+        double hGuess = 0.0;
+    };
+    Snapshot snapshot() const { return {mX, mV, mDvGuess, mHGuess}; }
+    void restore(const Snapshot& s);
+
+    double kineticEnergy() const;
+    double potentialEnergy(const Vec3& gravity) const; // −Σ m g·x (J)
+    double elasticEnergy(double t);                    // J, at the current positions
+    double maxEdgeStretch() const;                     // max |e| / |e_rest|
+    const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
+
+protected:
+    Body(std::string name, const VecX& restPositions);
+
+    // Vertex pairs coupled by any element (for the matrix pattern), edges for the stretch
+    // monitor; call once from the subclass constructor via `finishSetup`.
+    virtual void couplings(std::vector<std::pair<int, int>>& pairs) const = 0;
+    virtual void addForces(const ForceInput& in, ForceOutput& out) = 0;
+    void finishSetup(const std::vector<std::array<int, 2>>& edges);
+    const BlockMatrix& matrix() const { return mA; }
+
+    std::string mName;
+    VecX mX, mV, mMass, mRest;
+    StepOptions mOptions;
+    TroubleLimits mLimits;
+
+private:
+    void contactConstraints(const Environment& env, double t, double h);
+    int resolveContacts(const Environment& env, double t1, double h);
+    void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity);
+
+    std::vector<int> mPinned;             // vertex per pin
+    std::vector<int> mPinSet;             // index into mPinSets per pin
+    std::vector<PinSet> mPinSets;
+    VecX mAnchor;                         // 3 per pin: initial position
+    std::vector<uint8_t> mHeld;           // vertices in no element: held in place
+    std::vector<std::array<int, 2>> mEdges;
+    std::vector<double> mEdgeRest;
+    BlockMatrix mA;
+    FilteredSolver mSolver;
+    Constraints mConstraints;
+    std::vector<double> mContactImpulse;  // per vertex: suppressed normal speed (m/s)
+    std::vector<int> mContactCollider;    // per vertex: collider holding it in the solve, or -1
+    VecX mWind, mF, mKv, mDv, mDvGuess, mB;
+    double mHGuess = 0.0;
+};
+
+} // namespace gale::solver

@@ -1,0 +1,141 @@
+// Baraff–Witkin membrane, Bergou quadratic bending and hair springs (equations in elastic.h).
+#include "solver/elastic.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gale::solver {
+
+bool makeMembraneRest(const Vec3 uv[3], MembraneRest& out) {
+    out = MembraneRest{};
+    // Dm = [uv1 − uv0, uv2 − uv0] (2×2); F = Ds Dm⁻¹ with Ds = [x1 − x0, x2 − x0].
+    const double a = uv[1].x() - uv[0].x(), b = uv[2].x() - uv[0].x();
+    const double c = uv[1].y() - uv[0].y(), d = uv[2].y() - uv[0].y();
+    const double det = a * d - b * c;
+    const double scale = std::max({std::abs(a), std::abs(b), std::abs(c), std::abs(d)});
+    if (!(std::abs(det) > 1e-10 * scale * scale) || !std::isfinite(det)) return false;
+    const double inv00 = d / det, inv01 = -b / det, inv10 = -c / det, inv11 = a / det;
+    // Row k of Dm⁻¹ gives ∂F/∂x_{k+1}: g_1 = (inv00, inv01), g_2 = (inv10, inv11).
+    out.g = {-(inv00 + inv10), -(inv01 + inv11), inv00, inv01, inv10, inv11};
+    out.area = 0.5 * std::abs(det);
+    return true;
+}
+
+void materialCoordinates(const Vec3 x[3], const Vec3& warp, Vec3 uv[3]) {
+    const Vec3 e1 = x[1] - x[0], e2 = x[2] - x[0];
+    Vec3 n = e1.cross(e2);
+    const double nn = n.norm();
+    if (!(nn > 0.0)) {
+        for (int i = 0; i < 3; ++i) uv[i] = Vec3::Zero();
+        return;
+    }
+    n /= nn;
+    Vec3 u = warp - warp.dot(n) * n;
+    if (u.norm() < 0.3 * warp.norm()) {
+        const Vec3 alt = Vec3::UnitY();
+        u = alt - alt.dot(n) * n;
+        if (u.norm() < 0.3) u = e1;
+    }
+    u.normalize();
+    const Vec3 v = n.cross(u);
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 p = x[i] - x[0];
+        uv[i] = Vec3(p.dot(u), p.dot(v), 0.0);
+    }
+}
+
+void membraneForces(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
+                    TriangleElastic& out) {
+    out.energy = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        out.f[i].setZero();
+        for (int j = 0; j < 3; ++j) out.K[i][j].setZero();
+    }
+    if (!(rest.area > 0.0)) return;
+    const double* g = rest.g.data();
+    Vec3 wu = Vec3::Zero(), wv = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) {
+        wu += g[2 * i] * x[i];
+        wv += g[2 * i + 1] * x[i];
+    }
+    const double A = rest.area;
+    const double lu = wu.norm(), lv = wv.norm();
+    const Vec3 hu = lu > 0.0 ? Vec3(wu / lu) : Vec3::Zero();
+    const Vec3 hv = lv > 0.0 ? Vec3(wv / lv) : Vec3::Zero();
+    const double shear = wu.dot(wv);
+    out.energy = A * (0.5 * kStretch * ((lu - 1.0) * (lu - 1.0) + (lv - 1.0) * (lv - 1.0)) +
+                      0.5 * kShear * shear * shear);
+    // ∂E/∂w_u, ∂E/∂w_v (per unit area).
+    const Vec3 gu = kStretch * (lu - 1.0) * hu + kShear * shear * wv;
+    const Vec3 gv = kStretch * (lv - 1.0) * hv + kShear * shear * wu;
+    // Hessian blocks in (w_u, w_v) space.
+    const Mat3 I = Mat3::Identity();
+    const double tu = lu > 1.0 ? 1.0 - 1.0 / lu : 0.0;
+    const double tv = lv > 1.0 ? 1.0 - 1.0 / lv : 0.0;
+    const Mat3 Huu = kStretch * (hu * hu.transpose() + tu * (I - hu * hu.transpose())) +
+                     kShear * wv * wv.transpose();
+    const Mat3 Hvv = kStretch * (hv * hv.transpose() + tv * (I - hv * hv.transpose())) +
+                     kShear * wu * wu.transpose();
+    const Mat3 Huv = kShear * wv * wu.transpose();
+    const Mat3 Hvu = Huv.transpose();
+    for (int i = 0; i < 3; ++i) {
+        const double ai = g[2 * i], bi = g[2 * i + 1];
+        out.f[i] = -A * (ai * gu + bi * gv);
+        for (int j = 0; j < 3; ++j) {
+            const double aj = g[2 * j], bj = g[2 * j + 1];
+            out.K[i][j] = A * (ai * aj * Huu + ai * bj * Huv + bi * aj * Hvu + bi * bj * Hvv);
+        }
+    }
+}
+
+namespace {
+// cot of the angle between a and b.
+double cotangent(const Vec3& a, const Vec3& b) {
+    const double s = a.cross(b).norm();
+    return a.dot(b) / s;
+}
+} // namespace
+
+bool makeHingeRest(const Vec3 x[4], HingeRest& out) {
+    out = HingeRest{};
+    const Vec3 e0 = x[1] - x[0];
+    const double a0 = 0.5 * e0.cross(x[2] - x[0]).norm();
+    const double a1 = 0.5 * e0.cross(x[3] - x[0]).norm();
+    const double len2 = e0.squaredNorm();
+    // Reject hinges with a sliver triangle: their cotangents are unbounded.
+    if (!(a0 > 1e-8 * len2) || !(a1 > 1e-8 * len2)) return false;
+    const double cotAlpha = cotangent(x[1] - x[0], x[2] - x[0]); // at x0 in triangle 0
+    const double cotGamma = cotangent(x[1] - x[0], x[3] - x[0]); // at x0 in triangle 1
+    const double cotBeta = cotangent(x[0] - x[1], x[2] - x[1]);  // at x1 in triangle 0
+    const double cotDelta = cotangent(x[0] - x[1], x[3] - x[1]); // at x1 in triangle 1
+    out.k = {cotBeta + cotDelta, cotAlpha + cotGamma, -(cotAlpha + cotBeta), -(cotGamma + cotDelta)};
+    out.scale = 3.0 / (a0 + a1);
+    for (double c : out.k)
+        if (!std::isfinite(c)) {
+            out = HingeRest{};
+            return false;
+        }
+    return true;
+}
+
+void springForces(const Vec3& x0, const Vec3& x1, double restLength, double ea, SpringElastic& out) {
+    out = SpringElastic{};
+    if (!(restLength > 0.0)) return;
+    const Vec3 e = x1 - x0;
+    const double len = e.norm();
+    const double k = ea / restLength; // N/m
+    const double stretch = len - restLength;
+    out.energy = 0.5 * k * stretch * stretch;
+    if (!(len > 0.0)) return;
+    const Vec3 u = e / len;
+    out.f0 = k * stretch * u; // pulls x0 towards x1 when stretched
+    const double t = len > restLength ? 1.0 - restLength / len : 0.0;
+    out.K = k * (u * u.transpose() + t * (Mat3::Identity() - u * u.transpose()));
+}
+
+std::array<double, 3> strandBendWeights(double lPrev, double lNext) {
+    const double a = 1.0 / lPrev, c = 1.0 / lNext;
+    return {a, -(a + c), c};
+}
+
+} // namespace gale::solver

@@ -1,0 +1,316 @@
+// Block-sparse matrix, Baraff–Witkin constraint filter, PCG and LDLᵀ solves (see linear.h).
+#include "solver/linear.h"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace gale::solver {
+
+// ---------------------------------------------------------------------------------------------
+// BlockMatrix
+
+void BlockMatrix::build(int n, const std::vector<std::pair<int, int>>& pairs) {
+    mN = n;
+    std::vector<std::vector<int>> rows(n);
+    for (int i = 0; i < n; ++i) rows[i].push_back(i);
+    for (const auto& p : pairs) {
+        if (p.first == p.second) continue;
+        rows[p.first].push_back(p.second);
+        rows[p.second].push_back(p.first);
+    }
+    mBlockRowStart.assign(n + 1, 0);
+    mBlockCols.clear();
+    for (int i = 0; i < n; ++i) {
+        std::sort(rows[i].begin(), rows[i].end());
+        rows[i].erase(std::unique(rows[i].begin(), rows[i].end()), rows[i].end());
+        mBlockRowStart[i + 1] = mBlockRowStart[i] + static_cast<int>(rows[i].size());
+        mBlockCols.insert(mBlockCols.end(), rows[i].begin(), rows[i].end());
+    }
+    // Scalar CSR: row 3i+a holds 3 entries per block of block row i, columns sorted.
+    const int nnz = 9 * static_cast<int>(mBlockCols.size());
+    mA = Eigen::SparseMatrix<double, Eigen::RowMajor>(3 * n, 3 * n);
+    mA.resizeNonZeros(nnz);
+    int* outer = mA.outerIndexPtr();
+    int* inner = mA.innerIndexPtr();
+    int pos = 0;
+    for (int i = 0; i < n; ++i) {
+        const int nb = mBlockRowStart[i + 1] - mBlockRowStart[i];
+        for (int a = 0; a < 3; ++a) {
+            outer[3 * i + a] = pos;
+            for (int k = mBlockRowStart[i]; k < mBlockRowStart[i + 1]; ++k)
+                for (int c = 0; c < 3; ++c) inner[pos++] = 3 * mBlockCols[k] + c;
+        }
+        (void)nb;
+    }
+    outer[3 * n] = pos;
+    std::fill(mA.valuePtr(), mA.valuePtr() + nnz, 0.0);
+    mSlotBase.resize(mBlockCols.size());
+    mSlotStride.resize(mBlockCols.size());
+    mDiagSlot.assign(n, -1);
+    for (int i = 0; i < n; ++i) {
+        const int nb = mBlockRowStart[i + 1] - mBlockRowStart[i];
+        for (int k = mBlockRowStart[i]; k < mBlockRowStart[i + 1]; ++k) {
+            mSlotBase[k] = outer[3 * i] + 3 * (k - mBlockRowStart[i]);
+            mSlotStride[k] = 3 * nb;
+            if (mBlockCols[k] == i) mDiagSlot[i] = k;
+        }
+    }
+}
+
+int BlockMatrix::slot(int i, int j) const {
+    auto b = mBlockCols.begin() + mBlockRowStart[i], e = mBlockCols.begin() + mBlockRowStart[i + 1];
+    auto it = std::lower_bound(b, e, j);
+    return (it != e && *it == j) ? static_cast<int>(it - mBlockCols.begin()) : -1;
+}
+
+void BlockMatrix::setZero() { std::fill(mA.valuePtr(), mA.valuePtr() + mA.nonZeros(), 0.0); }
+
+Mat3 BlockMatrix::block(int slot) const {
+    const double* p = mA.valuePtr() + mSlotBase[slot];
+    const int s = mSlotStride[slot];
+    Mat3 m;
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) m(a, c) = p[a * s + c];
+    return m;
+}
+
+void BlockMatrix::setBlock(int slot, const Mat3& b) {
+    double* p = mA.valuePtr() + mSlotBase[slot];
+    const int s = mSlotStride[slot];
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) p[a * s + c] = b(a, c);
+}
+
+void BlockMatrix::multiply(const double* x, double* y) const {
+    const int* outer = mA.outerIndexPtr();
+    const int* inner = mA.innerIndexPtr();
+    const double* val = mA.valuePtr();
+    parallelChunks(static_cast<size_t>(3 * mN), 1536, [&](size_t r0, size_t r1) {
+        for (size_t r = r0; r < r1; ++r) {
+            double s = 0.0;
+            for (int p = outer[r]; p < outer[r + 1]; ++p) s += val[p] * x[inner[p]];
+            y[r] = s;
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Constraints
+
+bool Constraints::any() const {
+    for (uint8_t k : kind)
+        if (k) return true;
+    return false;
+}
+
+Mat3 Constraints::filter(size_t i) const {
+    switch (kind[i]) {
+    case 1:
+        return Mat3::Zero();
+    case 2: {
+        const Vec3 n = vec3At(normal.data(), i);
+        return Mat3::Identity() - n * n.transpose();
+    }
+    default:
+        return Mat3::Identity();
+    }
+}
+
+void Constraints::apply(double* x) const {
+    for (size_t i = 0; i < kind.size(); ++i) {
+        if (kind[i] == 1) {
+            x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
+        } else if (kind[i] == 2) {
+            const Vec3 n = vec3At(normal.data(), i);
+            Eigen::Map<Vec3> xi(x + 3 * i);
+            xi -= n.dot(xi) * n;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// FilteredSolver
+
+void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x,
+                                   VecX& out) {
+    // Â x = S A S x + (I − S) x
+    const bool constrained = !c.kind.empty() && c.any();
+    if (!constrained) {
+        A.multiply(x.data(), out.data());
+        return;
+    }
+    mTmp2 = x;
+    c.apply(mTmp2.data());
+    A.multiply(mTmp2.data(), out.data());
+    c.apply(out.data());
+    out += x - mTmp2;
+}
+
+SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
+                                  LinearSolverKind kind, double tolerance, int maxIterations) {
+    const int n3 = 3 * A.size();
+    if (dv.size() != n3) dv = VecX::Zero(n3);
+    // rhs = S (b − A z); initial y = S dv.
+    VecX z = VecX::Zero(n3);
+    if (!c.z.empty()) z = Eigen::Map<const VecX>(c.z.data(), n3);
+    mTmp.resize(n3);
+    A.multiply(z.data(), mTmp.data());
+    VecX rhs = b - mTmp;
+    c.apply(rhs.data());
+    VecX y = dv;
+    c.apply(y.data());
+    SolveStatus st = kind == LinearSolverKind::Direct ? solveDirect(A, c, rhs, y)
+                                                      : solvePcg(A, c, rhs, y, tolerance, maxIterations);
+    c.apply(y.data());
+    dv = y + z;
+    if (!dv.allFinite()) {
+        st.failed = true;
+        st.converged = false;
+    }
+    return st;
+}
+
+SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
+                                     VecX& y, double tolerance, int maxIterations) {
+    SolveStatus st;
+    const int n = A.size();
+    const size_t n3 = 3 * static_cast<size_t>(n);
+    // 3×3 block-Jacobi preconditioner of Â: (S_i A_ii S_i + I − S_i)⁻¹.
+    mPrecond.resize(n);
+    for (int i = 0; i < n; ++i) {
+        Mat3 d = A.block(A.diagonalSlot(i));
+        if (!c.kind.empty() && c.kind[i]) {
+            const Mat3 S = c.filter(i);
+            d = S * d * S + (Mat3::Identity() - S);
+        }
+        Mat3 inv;
+        bool ok = false;
+        double det = 0.0;
+        d.computeInverseAndDetWithCheck(inv, det, ok, 0.0);
+        if (!ok || !inv.allFinite()) {
+            const double dd = std::max(d.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+            inv = Mat3::Identity() / dd;
+        }
+        mPrecond[i] = inv;
+    }
+    auto precondition = [&](const VecX& r, VecX& out) {
+        parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i)
+                out.segment<3>(3 * i).noalias() = mPrecond[i] * r.segment<3>(3 * i);
+        });
+    };
+    const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
+    if (!std::isfinite(rhsNorm)) {
+        st.failed = true;
+        return st;
+    }
+    if (rhsNorm == 0.0) {
+        y.setZero();
+        st.converged = true;
+        return st;
+    }
+    mR.resize(n3);
+    mZ.resize(n3);
+    mP.resize(n3);
+    mQ.resize(n3);
+    applyFiltered(A, c, y, mQ);
+    mR = rhs - mQ;
+    double rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+    const double target = tolerance * rhsNorm;
+    if (rNorm <= target) {
+        st.converged = true;
+        st.residual = rNorm / rhsNorm;
+        return st;
+    }
+    precondition(mR, mZ);
+    mP = mZ;
+    double rz = deterministicDot(mR.data(), mZ.data(), n3);
+    int it = 0;
+    while (it < maxIterations) {
+        applyFiltered(A, c, mP, mQ);
+        const double pq = deterministicDot(mP.data(), mQ.data(), n3);
+        if (!(pq > 0.0) || !std::isfinite(pq)) {
+            st.failed = !std::isfinite(pq);
+            break;
+        }
+        const double alpha = rz / pq;
+        y += alpha * mP;
+        mR -= alpha * mQ;
+        ++it;
+        rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+        if (rNorm <= target) break;
+        precondition(mR, mZ);
+        const double rzNew = deterministicDot(mR.data(), mZ.data(), n3);
+        const double beta = rzNew / rz;
+        rz = rzNew;
+        mP = mZ + beta * mP;
+    }
+    st.iterations = it;
+    st.residual = rNorm / rhsNorm;
+    st.converged = rNorm <= target;
+    if (!std::isfinite(rNorm)) st.failed = true;
+    return st;
+}
+
+SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
+                                        VecX& y) {
+    SolveStatus st;
+    const auto& rowA = A.matrix();
+    // The pattern is symmetric and sorted, so the column-major arrays of Â equal the row-major
+    // ones: copy the values, then filter the constrained block rows and columns.
+    if (mFilteredA.rows() != rowA.rows() || mFilteredA.nonZeros() != rowA.nonZeros()) {
+        mFilteredA = ColMatrix(rowA); // establishes the (identical) pattern once
+        mLdlt.reset();
+    }
+    std::memcpy(mFilteredA.valuePtr(), rowA.valuePtr(), sizeof(double) * rowA.nonZeros());
+    const bool constrained = !c.kind.empty() && c.any();
+    if (constrained) {
+        // Column-major over a symmetric pattern: column 3j+a lists rows; entry (r, col).
+        const int* outer = mFilteredA.outerIndexPtr();
+        const int* inner = mFilteredA.innerIndexPtr();
+        double* val = mFilteredA.valuePtr();
+        const int n = A.size();
+        for (int j = 0; j < n; ++j) {
+            // Process block column j: for each block row i present, B ← S_i B S_j (+ I − S_j on
+            // the diagonal).
+            for (int p = outer[3 * j]; p < outer[3 * j + 1]; p += 3) {
+                const int i = inner[p] / 3;
+                if (!c.kind[i] && !c.kind[j]) continue;
+                const int stride = outer[3 * j + 1] - outer[3 * j];
+                Mat3 B;
+                for (int a = 0; a < 3; ++a)     // column offset
+                    for (int r = 0; r < 3; ++r) // row offset
+                        B(r, a) = val[p + a * stride + r];
+                const Mat3 Si = c.filter(i), Sj = c.filter(j);
+                Mat3 F = Si * B * Sj;
+                if (i == j) F += Mat3::Identity() - Sj;
+                for (int a = 0; a < 3; ++a)
+                    for (int r = 0; r < 3; ++r) val[p + a * stride + r] = F(r, a);
+            }
+        }
+    }
+    if (!mLdlt) {
+        mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
+        mLdlt->analyzePattern(mFilteredA);
+    }
+    mLdlt->factorize(mFilteredA);
+    if (mLdlt->info() != Eigen::Success) {
+        st.failed = true;
+        return st;
+    }
+    y = mLdlt->solve(rhs);
+    st.iterations = 1;
+    mQ.resize(rhs.size());
+    applyFiltered(A, c, y, mQ);
+    const double rn = std::sqrt(deterministicDot(rhs.data(), rhs.data(), rhs.size()));
+    const VecX res = mQ - rhs;
+    st.residual = rn > 0.0 ? std::sqrt(deterministicDot(res.data(), res.data(), res.size())) / rn : 0.0;
+    st.converged = std::isfinite(st.residual);
+    st.failed = !st.converged;
+    return st;
+}
+
+} // namespace gale::solver

@@ -1,0 +1,108 @@
+// The solver's part of a scene file — [[cloth]], [[hair]], [[collider]] and [solver] — read
+// with toml++ beside fields::loadScene's wind part (one file, one set of --set overrides), and
+// turned into bodies: meshes and strands loaded, painted maps evaluated, pins resolved.
+#pragma once
+
+#include "fields/pointset.h"
+#include "fields/scene.h"
+#include "solver/cloth.h"
+#include "solver/hair.h"
+#include "solver/world.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+// A per-vertex coefficient as written: a value (number or keys) times an optional map — a
+// PLY vertex property, or an expression over $P (rest position), $u, $v, $id.
+struct PaintedSpec {
+    fields::Param value{1.0};
+    std::string map;      // vertex property name ("" for none)
+    std::string exprPath; // expression file, resolved against the scene's folder
+    std::string source;   // inline expression
+    int line = 0, col = 0; // where it was written
+};
+
+// Pinned vertices: a list, a painted map (> 0.5 pins), a box, or any union of them, moved by
+// an optional keyframed translation.
+struct PinSpec {
+    std::vector<int> vertices;
+    std::string map;
+    bool hasBox = false;
+    double box[6] = {0, 0, 0, 0, 0, 0};
+    fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}};
+    int line = 0, col = 0;
+};
+
+struct ClothSpec {
+    std::string name;
+    std::string meshPath; // resolved; empty for a generated grid
+    double gridSize[2] = {1.0, 1.0};
+    int gridRes[2] = {16, 16};
+    Vec3 gridOrigin = Vec3::Zero();
+    std::string gridAxes = "xy"; // the plane of the grid: u along the first axis, v the second
+    ClothMaterial material;
+    PaintedSpec lift, drag;
+    bool hasPins = false;
+    PinSpec pins;
+    StepOptions step;
+    std::string output = "obj"; // obj | ply
+    int line = 0, col = 0;
+};
+
+struct HairSpec {
+    std::string name;
+    std::string strandsPath; // resolved; empty for generated strands
+    double gridSize[2] = {0.1, 0.1};
+    int gridCount[2] = {4, 4};
+    double length = 0.3;
+    int segments = 12;
+    Vec3 origin = Vec3::Zero();
+    Vec3 direction = -Vec3::UnitY();
+    HairMaterial material;
+    PaintedSpec dragNormal, dragTangent;
+    StepOptions step;
+    std::string output = "obj";
+    int line = 0, col = 0;
+    HairSpec() { step.linearSolver = LinearSolverKind::Direct; } // a chain's system is banded
+};
+
+// [solver]: the robustness limits (defaults in world.h / body.h).
+struct SolverSection {
+    int maxHalvings = 6;
+    double overStretch = 3.0;
+    double velocityJump = 50.0;
+};
+
+struct SimScene {
+    fields::Scene wind;
+    SolverSection solver;
+    std::vector<ClothSpec> cloths;
+    std::vector<HairSpec> hairs;
+    std::vector<Collider> colliders;
+};
+
+// Reads the whole scene: the wind part through fields::loadScene, the solver's sections here.
+// `sets` are `--set KEY=VALUE` overrides by dotted path (`cloth.cape.drag=0.8`,
+// `collider.0.radius=0.4`, `solver.max_halvings=4`, and the wind's own paths). Every problem
+// is reported at file:line:col; false when there were errors.
+bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
+                  const std::vector<std::string>& sets = {});
+
+// Loads meshes and strands, evaluates painted maps and pins, and makes the bodies. Problems
+// (a missing mesh, an unknown map, an expression error) come back as errors at the place in
+// the scene that named them; `warnings` gets notes such as degenerate-triangle counts.
+bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
+                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings);
+
+// World settings of a scene (threads: 0 for all hardware threads).
+WorldSettings worldSettings(const SimScene& scene, int threads);
+
+// A body's current shape for output: OBJ text (`v` lines, then `f` for cloth or `l` for
+// strands), or a point set with faces (cloth) or a `strand` column (hair) for PLY.
+std::string bodyObjText(const Body& body);
+fields::PointSet bodyPointSet(const Body& body);
+
+} // namespace gale::solver

@@ -1,0 +1,318 @@
+// From a loaded scene to bodies: meshes and strands read or generated, painted maps evaluated
+// once at the rest shape (PLY properties or expressions over $P, $u, $v, $id), pins resolved;
+// and the output geometry (OBJ text, PLY point sets) of a body's current shape.
+#include "solver/scene.h"
+
+#include "fields/expression_field.h"
+#include "lang/diagnostics.h"
+#include "runtime/program.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+namespace gale::solver {
+
+namespace {
+
+fields::SceneError sceneError(const SimScene& scene, int line, int col, std::string message) {
+    fields::SceneError e;
+    e.file = scene.wind.path;
+    e.line = line;
+    e.col = col;
+    e.message = std::move(message);
+    if (line > 0) {
+        std::ifstream in(scene.wind.path);
+        std::string text;
+        for (int i = 0; i < line && std::getline(in, text); ++i) {
+        }
+        e.sourceLine = text;
+    }
+    return e;
+}
+
+Vec3 axisOf(char c) { return c == 'x' ? Vec3::UnitX() : c == 'y' ? Vec3::UnitY() : Vec3::UnitZ(); }
+
+// Evaluates a painted map: a vertex property, or an expression (file or inline) at the rest
+// positions with $u, $v per vertex. Empty `values` when the spec has no map.
+bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::string& what,
+                 const std::vector<double>& positions, const std::vector<double>& u, const std::vector<double>& v,
+                 const std::map<std::string, std::vector<double>>& attributes, std::vector<double>& values,
+                 std::vector<fields::SceneError>& errors) {
+    values.clear();
+    const size_t n = positions.size() / 3;
+    if (!spec.map.empty()) {
+        auto it = attributes.find(spec.map);
+        if (it == attributes.end()) {
+            fields::SceneError e = sceneError(scene, spec.line, spec.col,
+                                              what + ": the geometry has no vertex property '" + spec.map + "'");
+            std::string names;
+            for (const auto& a : attributes) names += (names.empty() ? "" : ", ") + a.first;
+            e.notes.push_back(names.empty() ? "it has no extra vertex properties (a generated grid has none: "
+                                              "paint with expr = \"file.se\" or source = \"...\")"
+                                            : "its vertex properties: " + names);
+            errors.push_back(std::move(e));
+            return false;
+        }
+        values = it->second;
+        return true;
+    }
+    if (spec.exprPath.empty() && spec.source.empty()) return true;
+    lang::SourceFile source;
+    if (!spec.exprPath.empty()) {
+        std::ifstream in(spec.exprPath, std::ios::binary);
+        if (!in) {
+            fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": cannot read '" + spec.exprPath + "'");
+            e.io = true;
+            errors.push_back(std::move(e));
+            return false;
+        }
+        source = lang::SourceFile(spec.exprPath, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+    } else {
+        source = lang::SourceFile(scene.wind.path + " (" + what + ")", spec.source);
+    }
+    runtime::CompileSettings settings;
+    settings.variables = runtime::standardVariables();
+    settings.variables.push_back({"u", lang::Type::fp(1, lang::Lifetime::Varying)});
+    settings.variables.push_back({"v", lang::Type::fp(1, lang::Lifetime::Varying)});
+    settings.wantWidth = 1;
+    settings.functions = fields::fieldFunctions();
+    lang::DiagnosticSink sink;
+    std::shared_ptr<const runtime::Program> program = runtime::Program::compile(source, settings, sink);
+    if (!program) {
+        fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": the map expression has errors");
+        std::string rendered = lang::renderDiagnostics(source, sink);
+        while (!rendered.empty() && rendered.back() == '\n') rendered.pop_back();
+        e.notes.push_back(rendered);
+        errors.push_back(std::move(e));
+        return false;
+    }
+    runtime::EvalRequest req;
+    req.count = n;
+    req.uniforms = {{"t", {0.0}, ""}, {"frame", {0.0}, ""}, {"fps", {scene.wind.settings.fps}, ""}};
+    req.varyings = {{"P", 3, positions.data(), 3, 1}, {"u", 1, u.data(), 1, 1}, {"v", 1, v.data(), 1, 1}};
+    values.assign(n, 0.0);
+    runtime::EvalOutput<double> out;
+    out.data = values.data();
+    out.pointStride = 1;
+    const runtime::EvalResult r = runtime::evaluate<double>(*program, req, out);
+    if (!r.ok) {
+        errors.push_back(sceneError(scene, spec.line, spec.col, what + ": the map expression could not run: " + r.error));
+        return false;
+    }
+    size_t bad = 0;
+    for (double& x : values)
+        if (!std::isfinite(x) || x < 0.0) {
+            x = std::isfinite(x) ? 0.0 : 0.0;
+            ++bad;
+        }
+    if (bad) {
+        errors.push_back(sceneError(scene, spec.line, spec.col,
+                                    what + ": the map is negative or not finite at " + std::to_string(bad) +
+                                        " vertices (coefficients must be ≥ 0)"));
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
+WorldSettings worldSettings(const SimScene& scene, int threads) {
+    WorldSettings ws;
+    const fields::SceneSettings& s = scene.wind.settings;
+    ws.fps = s.fps;
+    ws.substeps = s.substeps;
+    ws.maxHalvings = scene.solver.maxHalvings;
+    if (s.gravity.size() >= 3) ws.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
+    ws.airDensity = s.airDensity;
+    ws.threads = threads;
+    return ws;
+}
+
+bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
+                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings) {
+    const size_t before = errors.size();
+    for (const ClothSpec& spec : scene.cloths) {
+        const std::string what = "[[cloth]] '" + spec.name + "'";
+        TriMesh mesh;
+        std::vector<double> u, v;
+        if (spec.meshPath.empty()) {
+            const Vec3 au = axisOf(spec.gridAxes[0]), av = axisOf(spec.gridAxes[1]);
+            mesh = makeGrid(spec.gridSize[0], spec.gridSize[1], spec.gridRes[0], spec.gridRes[1], spec.gridOrigin, au, av);
+            for (size_t i = 0; i < mesh.vertexCount(); ++i) {
+                u.push_back(mesh.uv[2 * i] / spec.gridSize[0]);
+                v.push_back(mesh.uv[2 * i + 1] / spec.gridSize[1]);
+            }
+        } else {
+            std::string error;
+            int dropped = 0;
+            if (!loadMesh(spec.meshPath, mesh, error, &dropped)) {
+                fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": " + error);
+                e.io = error.find("cannot open") != std::string::npos || error.find("No such file") != std::string::npos;
+                errors.push_back(std::move(e));
+                continue;
+            }
+            if (dropped) warnings.push_back(what + ": " + std::to_string(dropped) + " face(s) with bad indices were dropped");
+            const bool hasUv = mesh.uv.size() == 2 * mesh.vertexCount();
+            for (size_t i = 0; i < mesh.vertexCount(); ++i) {
+                u.push_back(hasUv ? mesh.uv[2 * i] : 0.0);
+                v.push_back(hasUv ? mesh.uv[2 * i + 1] : 0.0);
+            }
+        }
+        ClothMaterial mat = spec.material;
+        mat.lift.value = spec.lift.value;
+        mat.drag.value = spec.drag.value;
+        bool ok = evaluateMap(scene, spec.lift, what + " lift", mesh.positions, u, v, mesh.attributes, mat.lift.map, errors);
+        ok = evaluateMap(scene, spec.drag, what + " drag", mesh.positions, u, v, mesh.attributes, mat.drag.map, errors) && ok;
+        if (!ok) continue;
+        auto cloth = std::make_unique<Cloth>(spec.name, mesh, mat);
+        cloth->options() = spec.step;
+        cloth->limits().overStretch = scene.solver.overStretch;
+        cloth->limits().velocityJump = scene.solver.velocityJump;
+        if (cloth->degenerateTriangles())
+            warnings.push_back(what + ": " + std::to_string(cloth->degenerateTriangles()) +
+                               " degenerate triangle(s) take no stretch force");
+        if (spec.hasPins) {
+            PinSet pins;
+            pins.translate = spec.pins.translate;
+            const size_t n = mesh.vertexCount();
+            for (int idx : spec.pins.vertices) {
+                if (idx < 0 || static_cast<size_t>(idx) >= n) {
+                    errors.push_back(sceneError(scene, spec.pins.line, spec.pins.col,
+                                                what + " pins: vertex " + std::to_string(idx) + " is out of range (the mesh has " +
+                                                    std::to_string(n) + " vertices)"));
+                    ok = false;
+                    continue;
+                }
+                pins.vertices.push_back(idx);
+            }
+            if (!spec.pins.map.empty()) {
+                auto it = mesh.attributes.find(spec.pins.map);
+                if (it == mesh.attributes.end()) {
+                    errors.push_back(sceneError(scene, spec.pins.line, spec.pins.col,
+                                                what + " pins: the mesh has no vertex property '" + spec.pins.map + "'"));
+                    ok = false;
+                } else {
+                    for (size_t i = 0; i < n; ++i)
+                        if (it->second[i] > 0.5) pins.vertices.push_back(static_cast<int>(i));
+                }
+            }
+            if (spec.pins.hasBox) {
+                const double* b = spec.pins.box;
+                for (size_t i = 0; i < n; ++i) {
+                    const Vec3 p = mesh.position(i);
+                    if (p.x() >= std::min(b[0], b[3]) && p.x() <= std::max(b[0], b[3]) && p.y() >= std::min(b[1], b[4]) &&
+                        p.y() <= std::max(b[1], b[4]) && p.z() >= std::min(b[2], b[5]) && p.z() <= std::max(b[2], b[5]))
+                        pins.vertices.push_back(static_cast<int>(i));
+                }
+            }
+            if (ok && pins.vertices.empty())
+                warnings.push_back(what + ": the pins select no vertex");
+            cloth->addPins(pins);
+        }
+        if (ok) bodies.push_back(std::move(cloth));
+    }
+    for (const HairSpec& spec : scene.hairs) {
+        const std::string what = "[[hair]] '" + spec.name + "'";
+        Strands strands;
+        if (spec.strandsPath.empty()) {
+            const Vec3 d = spec.direction.normalized();
+            Vec3 a = d.cross(Vec3::UnitZ());
+            if (a.norm() < 1e-6) a = d.cross(Vec3::UnitX());
+            a.normalize();
+            const Vec3 b = d.cross(a).normalized();
+            strands = makeStrandGrid(spec.origin, spec.gridSize[0], spec.gridSize[1], spec.gridCount[0], spec.gridCount[1],
+                                     spec.length, spec.segments, a, b, d);
+        } else {
+            std::string error;
+            if (!loadStrands(spec.strandsPath, strands, error)) {
+                errors.push_back(sceneError(scene, spec.line, spec.col, what + ": " + error));
+                continue;
+            }
+        }
+        // $u: arc-length fraction from the root; $v: strand index / (strands − 1).
+        const size_t n = strands.vertexCount();
+        std::vector<double> u(n, 0.0), v(n, 0.0);
+        for (size_t s = 0; s < strands.strandCount(); ++s) {
+            const int b = strands.offsets[s], e = strands.offsets[s + 1];
+            double total = 0.0;
+            std::vector<double> acc(e - b, 0.0);
+            for (int i = b + 1; i < e; ++i) {
+                total += (vec3At(strands.positions.data(), i) - vec3At(strands.positions.data(), i - 1)).norm();
+                acc[i - b] = total;
+            }
+            for (int i = b; i < e; ++i) {
+                u[i] = total > 0 ? acc[i - b] / total : 0.0;
+                v[i] = strands.strandCount() > 1 ? static_cast<double>(s) / (strands.strandCount() - 1) : 0.0;
+            }
+        }
+        HairMaterial mat = spec.material;
+        mat.dragNormal.value = spec.dragNormal.value;
+        mat.dragTangent.value = spec.dragTangent.value;
+        bool ok = evaluateMap(scene, spec.dragNormal, what + " drag_normal", strands.positions, u, v, strands.attributes,
+                              mat.dragNormal.map, errors);
+        ok = evaluateMap(scene, spec.dragTangent, what + " drag_tangent", strands.positions, u, v, strands.attributes,
+                         mat.dragTangent.map, errors) && ok;
+        if (!ok) continue;
+        auto hair = std::make_unique<Hair>(spec.name, strands, mat);
+        hair->options() = spec.step;
+        hair->limits().overStretch = scene.solver.overStretch;
+        hair->limits().velocityJump = scene.solver.velocityJump;
+        bodies.push_back(std::move(hair));
+    }
+    return errors.size() == before;
+}
+
+std::string bodyObjText(const Body& body) {
+    std::string out;
+    out.reserve(body.vertexCount() * 40);
+    out += "# gale " + std::string(body.kind()) + " '" + body.name() + "'\n";
+    char buf[96];
+    const VecX& x = body.positions();
+    for (size_t i = 0; i < body.vertexCount(); ++i) {
+        std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        out += buf;
+    }
+    if (const Cloth* c = dynamic_cast<const Cloth*>(&body)) {
+        for (const auto& t : c->mesh().triangles) {
+            std::snprintf(buf, sizeof buf, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            out += buf;
+        }
+    } else if (const Hair* h = dynamic_cast<const Hair*>(&body)) {
+        const Strands& s = h->strands();
+        for (size_t k = 0; k < s.strandCount(); ++k) {
+            out += "l";
+            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i) out += " " + std::to_string(i + 1);
+            out += "\n";
+        }
+    }
+    return out;
+}
+
+fields::PointSet bodyPointSet(const Body& body) {
+    fields::PointSet ps;
+    const VecX& x = body.positions();
+    const VecX& v = body.velocities();
+    const char* names[6] = {"x", "y", "z", "vx", "vy", "vz"};
+    for (int c = 0; c < 6; ++c) {
+        std::vector<double> col(body.vertexCount());
+        const VecX& src = c < 3 ? x : v;
+        for (size_t i = 0; i < body.vertexCount(); ++i) col[i] = src[3 * i + c % 3];
+        ps.names.push_back(names[c]);
+        ps.columns.push_back(std::move(col));
+    }
+    if (const Cloth* c = dynamic_cast<const Cloth*>(&body)) {
+        for (const auto& t : c->mesh().triangles) ps.faces.push_back({t[0], t[1], t[2]});
+    } else if (const Hair* h = dynamic_cast<const Hair*>(&body)) {
+        std::vector<double> strand(body.vertexCount(), 0.0);
+        const Strands& s = h->strands();
+        for (size_t k = 0; k < s.strandCount(); ++k)
+            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i) strand[i] = static_cast<double>(k);
+        ps.names.push_back("strand");
+        ps.columns.push_back(std::move(strand));
+    }
+    return ps;
+}
+
+} // namespace gale::solver

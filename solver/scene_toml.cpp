@@ -1,0 +1,818 @@
+// Reading [[cloth]], [[hair]], [[collider]] and [solver] with toml++ (the only solver file that
+// includes it: it is slow to compile). --set overrides are applied to the TOML tree by dotted
+// path first; then every key is checked and converted, every problem reported at file:line:col.
+#include "solver/scene.h"
+
+#include "lang/functions.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace gale::solver {
+
+namespace {
+
+constexpr std::string_view kSetPrefix = "--set ";
+
+std::string trim(std::string_view s) {
+    const size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
+    return a == std::string_view::npos ? std::string() : std::string(s.substr(a, b - a + 1));
+}
+
+std::vector<std::string> splitDots(const std::string& s) {
+    std::vector<std::string> parts;
+    std::string part;
+    std::stringstream in(s);
+    while (std::getline(in, part, '.')) parts.push_back(part);
+    if (!s.empty() && s.back() == '.') parts.push_back("");
+    return parts;
+}
+
+std::string joinNames(const std::vector<std::string>& names) {
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+}
+
+std::string didYouMean(const std::string& name, const std::vector<std::string>& candidates) {
+    std::vector<std::string_view> views(candidates.begin(), candidates.end());
+    std::string_view close = lang::closestName(name, views);
+    return close.empty() ? std::string() : "did you mean '" + std::string(close) + "'?";
+}
+
+bool isNumber(const toml::node& n) { return n.is_integer() || n.is_floating_point(); }
+
+const char* typeName(const toml::node& n) {
+    switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date or time";
+    }
+}
+
+const std::vector<std::string> kClothKeys = {
+    "name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift", "drag",
+    "aero_model", "aero_jacobian", "pins", "linear_solver", "cg_tolerance", "cg_max_iterations",
+    "newton_iterations", "output"};
+const std::vector<std::string> kHairKeys = {
+    "name", "strands", "grid", "radius", "density", "stretch", "bend", "damping", "drag_normal",
+    "drag_tangent", "root_pinned", "pins", "linear_solver", "cg_tolerance", "cg_max_iterations",
+    "newton_iterations", "output"};
+const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
+                                                "a", "b", "thickness", "friction"};
+const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
+
+class Loader {
+public:
+    Loader(std::string path, const std::string& text, std::vector<fields::SceneError>& errors)
+        : mPath(std::move(path)), mText(text), mErrors(errors) {
+        size_t start = 0;
+        while (true) {
+            mLineStarts.push_back(start);
+            const size_t nl = text.find('\n', start);
+            if (nl == std::string::npos) break;
+            start = nl + 1;
+        }
+    }
+
+    void applySets(toml::table& root, const std::vector<std::string>& sets);
+    void load(const toml::table& root, const std::string& baseDir, SimScene& out);
+
+private:
+    fields::SceneError& error(const toml::source_region& where, std::string message) {
+        fields::SceneError e;
+        e.message = std::move(message);
+        if (where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
+            e.file = *where.path;
+        } else {
+            e.file = mPath;
+            e.line = static_cast<int>(where.begin.line);
+            e.col = static_cast<int>(where.begin.column);
+            e.sourceLine = lineText(e.line);
+        }
+        mErrors.push_back(std::move(e));
+        return mErrors.back();
+    }
+    fields::SceneError& error(const toml::node& at, std::string message) {
+        return error(at.source(), std::move(message));
+    }
+    fields::SceneError& setError(const std::string& set, std::string message) {
+        fields::SceneError e;
+        e.file = std::string(kSetPrefix) + set;
+        e.message = std::move(message);
+        mErrors.push_back(std::move(e));
+        return mErrors.back();
+    }
+    std::string lineText(int line) const {
+        if (line <= 0 || static_cast<size_t>(line) > mLineStarts.size()) return {};
+        const size_t a = mLineStarts[static_cast<size_t>(line - 1)];
+        size_t b = mText.find('\n', a);
+        if (b == std::string::npos) b = mText.size();
+        if (b > a && mText[b - 1] == '\r') --b;
+        return mText.substr(a, b - a);
+    }
+
+    void checkKeys(const toml::table& t, const std::vector<std::string>& allowed, const std::string& section);
+    bool number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin);
+    bool integer(const toml::node& n, const std::string& what, long long& out, long long min);
+    bool string(const toml::node& n, const std::string& what, std::string& out);
+    bool choice(const toml::node& n, const std::string& what, const std::vector<std::string>& options,
+                std::string& out);
+    bool boolean(const toml::node& n, const std::string& what, bool& out);
+    bool vec3(const toml::node& n, const std::string& what, Vec3& out);
+    bool numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out);
+    std::optional<fields::Param> param(const toml::node& n, const std::string& what, int width, double min);
+    std::optional<fields::Param> keyframes(const toml::table& t, const std::string& what, int width, double min);
+    bool painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out);
+    bool pins(const toml::node& n, const std::string& what, PinSpec& out);
+    void stepOptions(const toml::table& t, const std::string& what, StepOptions& s, std::string& output);
+
+    void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
+    void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
+    void loadCollider(const toml::table& t, size_t index, Collider& c);
+    void loadSolver(const toml::table& t, SolverSection& s);
+
+    std::string mPath;
+    const std::string& mText;
+    std::vector<size_t> mLineStarts;
+    std::vector<fields::SceneError>& mErrors;
+};
+
+// ---- --set ------------------------------------------------------------------------------------
+
+void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) {
+    for (const std::string& set : sets) {
+        const size_t eq = set.find('=');
+        if (eq == std::string::npos) continue; // the wind loader reports the malformed ones
+        const std::string key = trim(set.substr(0, eq));
+        const std::string text = trim(set.substr(eq + 1));
+        const std::vector<std::string> parts = splitDots(key);
+        if (parts.empty() || text.empty() ||
+            std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); }))
+            continue;
+        const std::string& head = parts[0];
+        if (head != "cloth" && head != "hair" && head != "collider" && head != "solver") continue;
+
+        const std::string origin = std::string(kSetPrefix) + set;
+        toml::table doc;
+        bool parsed = false;
+        for (const std::string& candidate : {text, "[" + text + "]"}) {
+            try {
+                doc = toml::parse("v = " + candidate, origin);
+                parsed = true;
+                break;
+            } catch (const toml::parse_error&) {
+            }
+        }
+        if (!parsed) {
+            std::string quoted = "\"";
+            for (char c : text) {
+                if (c == '"' || c == '\\') quoted += '\\';
+                quoted += c;
+            }
+            try {
+                doc = toml::parse("v = " + quoted + "\"", origin);
+                parsed = true;
+            } catch (const toml::parse_error&) {
+            }
+        }
+        if (!parsed || !doc.get("v")) {
+            setError(set, "cannot read the value '" + text + "'");
+            continue;
+        }
+        toml::table* target = nullptr;
+        size_t next = 1;
+        std::string where = head;
+        if (head == "solver") {
+            if (!root.contains("solver")) root.insert("solver", toml::table{});
+            target = root.get("solver")->as_table();
+            if (!target) {
+                setError(set, "'solver' in the scene is not a table");
+                continue;
+            }
+        } else {
+            if (parts.size() < 3) {
+                setError(set, "expected " + head + ".NAME.KEY (or " + head + ".INDEX.KEY, from 0)");
+                continue;
+            }
+            toml::array* list = root.get(head) ? root.get(head)->as_array() : nullptr;
+            std::vector<std::string> names;
+            if (list)
+                for (size_t i = 0; i < list->size(); ++i) {
+                    toml::table* t = list->get(i)->as_table();
+                    if (!t) continue;
+                    std::string name = t->get("name") && t->get("name")->is_string()
+                                           ? t->get("name")->value<std::string>().value_or("")
+                                           : head + std::to_string(i);
+                    names.push_back(name);
+                    if (!target && (name == parts[1] || parts[1] == std::to_string(i))) target = t;
+                }
+            if (!target) {
+                fields::SceneError& e = setError(set, "the scene has no [[" + head + "]] named '" + parts[1] + "'");
+                const std::string hint = didYouMean(parts[1], names);
+                if (!hint.empty()) e.notes.push_back(hint);
+                const size_t count = list ? list->size() : 0;
+                e.notes.push_back("it has " + std::to_string(count) + " [[" + head + "]] entr" +
+                                  (count == 1 ? "y" : "ies") +
+                                  (names.empty() ? std::string() : " (" + joinNames(names) + ")") +
+                                  "; name one, or give its index from 0");
+                continue;
+            }
+            next = 2;
+            where = head + "." + parts[1];
+        }
+        bool ok = true;
+        for (size_t i = next; ok && i + 1 < parts.size(); ++i) {
+            where += "." + parts[i];
+            toml::node* child = target->get(parts[i]);
+            if (!child) {
+                target->insert(parts[i], toml::table{});
+                child = target->get(parts[i]);
+            }
+            target = child->as_table();
+            if (!target) {
+                setError(set, "'" + where + "' is " + typeName(*child) + ", not a table");
+                ok = false;
+            }
+        }
+        if (ok) target->insert_or_assign(parts.back(), std::move(*doc.get("v")));
+    }
+}
+
+// ---- values -----------------------------------------------------------------------------------
+
+void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                       const std::string& section) {
+    for (auto&& [key, node] : t) {
+        const std::string name(key.str());
+        if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
+        fields::SceneError& e = error(key.source().begin.line ? key.source() : node.source(),
+                                      "unknown key '" + name + "' in " + section);
+        const std::string hint = didYouMean(name, allowed);
+        if (!hint.empty()) e.notes.push_back(hint);
+        e.notes.push_back(section + " keys: " + joinNames(allowed));
+    }
+}
+
+bool Loader::number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin) {
+    if (!isNumber(n)) {
+        error(n, what + " must be a number, not " + typeName(n));
+        return false;
+    }
+    const double v = n.value<double>().value_or(0.0);
+    if (!std::isfinite(v)) {
+        error(n, what + " must be a finite number");
+        return false;
+    }
+    if (strictMin ? !(v > min) : !(v >= min)) {
+        error(n, what + " must be " + (strictMin ? "greater than " : "at least ") + fields::formatNumber(min) +
+                     ", not " + fields::formatNumber(v));
+        return false;
+    }
+    out = v;
+    return true;
+}
+
+bool Loader::integer(const toml::node& n, const std::string& what, long long& out, long long min) {
+    long long v = 0;
+    if (n.is_integer()) {
+        v = n.value<long long>().value_or(0);
+    } else if (n.is_floating_point() && std::isfinite(n.value<double>().value_or(0.5)) &&
+               n.value<double>().value_or(0.5) == std::floor(n.value<double>().value_or(0.5))) {
+        v = static_cast<long long>(n.value<double>().value_or(0.0));
+    } else {
+        error(n, what + " must be a whole number, not " +
+                     (n.is_floating_point() ? std::string("a fraction") : typeName(n)));
+        return false;
+    }
+    if (v < min) {
+        error(n, what + " must be at least " + std::to_string(min) + ", not " + std::to_string(v));
+        return false;
+    }
+    out = v;
+    return true;
+}
+
+bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
+    if (!n.is_string()) {
+        error(n, what + " must be a string, not " + typeName(n));
+        return false;
+    }
+    out = n.value<std::string>().value_or("");
+    return true;
+}
+
+bool Loader::choice(const toml::node& n, const std::string& what, const std::vector<std::string>& options,
+                    std::string& out) {
+    std::string v;
+    if (!string(n, what, v)) return false;
+    if (std::find(options.begin(), options.end(), v) == options.end()) {
+        std::string list;
+        for (const std::string& o : options) list += (list.empty() ? "\"" : ", \"") + o + "\"";
+        fields::SceneError& e = error(n, "unknown " + what + " '" + v + "' (use " + list + ")");
+        const std::string hint = didYouMean(v, options);
+        if (!hint.empty()) e.notes.push_back(hint);
+        return false;
+    }
+    out = v;
+    return true;
+}
+
+bool Loader::boolean(const toml::node& n, const std::string& what, bool& out) {
+    if (!n.is_boolean()) {
+        error(n, what + " must be true or false, not " + typeName(n));
+        return false;
+    }
+    out = n.value<bool>().value_or(false);
+    return true;
+}
+
+bool Loader::numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out) {
+    out.clear();
+    const toml::array* a = n.as_array();
+    bool ok = a && a->size() == count;
+    if (ok)
+        for (const toml::node& e : *a) {
+            if (!isNumber(e) || !std::isfinite(e.value<double>().value_or(NAN))) {
+                ok = false;
+                break;
+            }
+            out.push_back(e.value<double>().value_or(0.0));
+        }
+    if (!ok) error(n, what + " must be an array of " + std::to_string(count) + " numbers");
+    return ok;
+}
+
+bool Loader::vec3(const toml::node& n, const std::string& what, Vec3& out) {
+    std::vector<double> v;
+    if (!numbers(n, what, 3, v)) return false;
+    out = Vec3(v[0], v[1], v[2]);
+    return true;
+}
+
+std::optional<fields::Param> Loader::param(const toml::node& n, const std::string& what, int width, double min) {
+    if (const toml::table* t = n.as_table()) return keyframes(*t, what, width, min);
+    if (width == 1) {
+        double v = 0.0;
+        if (!isNumber(n)) {
+            error(n, what + " must be a number or a keyframed curve { keys = [[t0, v0], [t1, v1]] }, not " +
+                         typeName(n));
+            return std::nullopt;
+        }
+        if (!number(n, what, v, min, false)) return std::nullopt;
+        return fields::Param(v);
+    }
+    std::vector<double> v;
+    if (!numbers(n, what, static_cast<size_t>(width), v)) return std::nullopt;
+    return fields::Param(std::move(v));
+}
+
+std::optional<fields::Param> Loader::keyframes(const toml::table& t, const std::string& what, int width,
+                                               double min) {
+    checkKeys(t, {"keys", "interp"}, "the keyframed curve of " + what);
+    fields::KeyInterp interp = fields::KeyInterp::Linear;
+    bool ok = true;
+    if (const toml::node* i = t.get("interp")) {
+        std::string name;
+        if (choice(*i, "interpolation of " + what, {"linear", "smooth", "step"}, name))
+            interp = name == "smooth" ? fields::KeyInterp::Smooth
+                                      : name == "step" ? fields::KeyInterp::Step : fields::KeyInterp::Linear;
+        else
+            ok = false;
+    }
+    const toml::node* keysNode = t.get("keys");
+    const toml::array* keys = keysNode ? keysNode->as_array() : nullptr;
+    if (!keys || keys->empty()) {
+        error(keysNode ? *keysNode : static_cast<const toml::node&>(t),
+              what + ": a keyframed curve needs keys = [[t0, v0], [t1, v1], ...]");
+        return std::nullopt;
+    }
+    std::vector<std::pair<double, std::vector<double>>> list;
+    for (const toml::node& k : *keys) {
+        const toml::array* pair = k.as_array();
+        if (!pair || pair->size() != 2 || !isNumber(*pair->get(0))) {
+            error(k, what + ": each key must be [time, value] (time in seconds)");
+            ok = false;
+            continue;
+        }
+        double time = 0.0;
+        if (!number(*pair->get(0), what + ": a key's time", time, -1e300, false)) {
+            ok = false;
+            continue;
+        }
+        std::vector<double> value;
+        if (width == 1) {
+            double v = 0.0;
+            if (!number(*pair->get(1), what + ": a key's value", v, min, false)) {
+                ok = false;
+                continue;
+            }
+            value.push_back(v);
+        } else if (!numbers(*pair->get(1), what + ": a key's value", static_cast<size_t>(width), value)) {
+            ok = false;
+            continue;
+        }
+        for (const auto& e : list)
+            if (e.first == time) {
+                error(k, what + ": two keys at time " + fields::formatNumber(time));
+                ok = false;
+            }
+        list.push_back({time, std::move(value)});
+    }
+    if (!ok) return std::nullopt;
+    std::stable_sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<double> times;
+    std::vector<std::vector<double>> values;
+    for (auto& e : list) {
+        times.push_back(e.first);
+        values.push_back(std::move(e.second));
+    }
+    return fields::Param::keyed(std::move(times), std::move(values), interp);
+}
+
+bool Loader::painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out) {
+    out.line = static_cast<int>(n.source().begin.line);
+    out.col = static_cast<int>(n.source().begin.column);
+    const toml::table* t = n.as_table();
+    if (!t || t->contains("keys")) {
+        std::optional<fields::Param> p = param(n, what, 1, 0.0);
+        if (!p) return false;
+        out.value = *p;
+        return true;
+    }
+    // { map = "prop" | expr = "file.se" | source = "...", scale = value }
+    checkKeys(*t, {"map", "expr", "source", "scale"}, "the painted map of " + what);
+    bool ok = true;
+    int kinds = 0;
+    if (const toml::node* m = t->get("map")) {
+        ok = string(*m, what + ": map", out.map) && ok;
+        ++kinds;
+    }
+    if (const toml::node* e = t->get("expr")) {
+        std::string file;
+        if (string(*e, what + ": expr", file))
+            out.exprPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+        else
+            ok = false;
+        ++kinds;
+    }
+    if (const toml::node* s = t->get("source")) {
+        ok = string(*s, what + ": source", out.source) && ok;
+        ++kinds;
+    }
+    if (kinds != 1) {
+        error(n, what + ": a painted map needs exactly one of map = \"vertex property\", "
+                        "expr = \"file.se\" or source = \"expression\"");
+        return false;
+    }
+    out.value = fields::Param(1.0);
+    if (const toml::node* s = t->get("scale")) {
+        std::optional<fields::Param> p = param(*s, what + ": scale", 1, 0.0);
+        if (p)
+            out.value = *p;
+        else
+            ok = false;
+    }
+    return ok;
+}
+
+bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
+    out.line = static_cast<int>(n.source().begin.line);
+    out.col = static_cast<int>(n.source().begin.column);
+    const toml::table* t = n.as_table();
+    if (!t) {
+        error(n, what + " must be a table: { vertices = [...] }, { map = \"pin\" } or "
+                        "{ box = [x0, y0, z0, x1, y1, z1] }, not " + typeName(n));
+        return false;
+    }
+    checkKeys(*t, {"vertices", "map", "box", "translate"}, what);
+    bool ok = true;
+    if (const toml::node* v = t->get("vertices")) {
+        const toml::array* a = v->as_array();
+        if (!a) {
+            error(*v, what + ": vertices must be an array of vertex indices");
+            ok = false;
+        } else {
+            for (const toml::node& e : *a) {
+                long long idx = 0;
+                if (integer(e, what + ": a vertex index", idx, 0))
+                    out.vertices.push_back(static_cast<int>(idx));
+                else
+                    ok = false;
+            }
+        }
+    }
+    if (const toml::node* m = t->get("map")) ok = string(*m, what + ": map", out.map) && ok;
+    if (const toml::node* b = t->get("box")) {
+        std::vector<double> v;
+        if (numbers(*b, what + ": box", 6, v)) {
+            out.hasBox = true;
+            for (int k = 0; k < 6; ++k) out.box[k] = v[k];
+        } else {
+            ok = false;
+        }
+    }
+    if (!t->get("vertices") && !t->get("map") && !t->get("box")) {
+        error(n, what + " needs vertices = [...], map = \"property\" or box = [x0, y0, z0, x1, y1, z1]");
+        ok = false;
+    }
+    if (const toml::node* tr = t->get("translate")) {
+        std::optional<fields::Param> p = param(*tr, what + ": translate", 3, -1e300);
+        if (p)
+            out.translate = *p;
+        else
+            ok = false;
+    }
+    return ok;
+}
+
+void Loader::stepOptions(const toml::table& t, const std::string& what, StepOptions& s, std::string& output) {
+    if (const toml::node* n = t.get("linear_solver")) {
+        std::string v;
+        if (choice(*n, "linear_solver", {"pcg", "direct"}, v))
+            s.linearSolver = v == "direct" ? LinearSolverKind::Direct : LinearSolverKind::Pcg;
+    }
+    if (const toml::node* n = t.get("cg_tolerance")) number(*n, what + ": cg_tolerance", s.cgTolerance, 0.0, true);
+    if (const toml::node* n = t.get("cg_max_iterations")) {
+        long long v = 0;
+        if (integer(*n, what + ": cg_max_iterations", v, 1)) s.cgMaxIterations = static_cast<int>(std::min(v, 1000000LL));
+    }
+    if (const toml::node* n = t.get("newton_iterations")) {
+        long long v = 0;
+        if (integer(*n, what + ": newton_iterations", v, 0)) s.newtonIterations = static_cast<int>(std::min(v, 20LL));
+    }
+    if (const toml::node* n = t.get("output")) choice(*n, "output format", {"obj", "ply"}, output);
+}
+
+// ---- sections -------------------------------------------------------------------------------
+
+void Loader::loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c) {
+    c.line = static_cast<int>(t.source().begin.line);
+    c.col = static_cast<int>(t.source().begin.column);
+    c.name = "cloth" + std::to_string(index);
+    if (const toml::node* n = t.get("name")) string(*n, "[[cloth]] name", c.name);
+    const std::string what = "[[cloth]] '" + c.name + "'";
+    checkKeys(t, kClothKeys, "[[cloth]]");
+    const toml::node* mesh = t.get("mesh");
+    const toml::node* grid = t.get("grid");
+    if ((mesh != nullptr) == (grid != nullptr)) {
+        error(t, what + " needs exactly one of mesh = \"file.obj|ply\" or grid = { size = [w, h], res = [nx, ny] }");
+    } else if (mesh) {
+        std::string file;
+        if (string(*mesh, what + ": mesh", file))
+            c.meshPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    } else if (const toml::table* g = grid->as_table()) {
+        checkKeys(*g, {"size", "res", "origin", "axes"}, what + " grid");
+        std::vector<double> v;
+        if (const toml::node* s = g->get("size"))
+            if (numbers(*s, what + ": grid size", 2, v)) {
+                if (!(v[0] > 0 && v[1] > 0))
+                    error(*s, what + ": grid size must be positive");
+                c.gridSize[0] = v[0];
+                c.gridSize[1] = v[1];
+            }
+        if (const toml::node* r = g->get("res")) {
+            const toml::array* a = r->as_array();
+            if (!a || a->size() != 2) {
+                error(*r, what + ": grid res must be [nx, ny] (vertices along each side)");
+            } else {
+                for (int k = 0; k < 2; ++k) {
+                    long long x = 0;
+                    if (integer(*a->get(k), what + ": grid res", x, 2)) c.gridRes[k] = static_cast<int>(std::min(x, 4096LL));
+                }
+            }
+        }
+        if (const toml::node* o = g->get("origin")) vec3(*o, what + ": grid origin", c.gridOrigin);
+        if (const toml::node* a = g->get("axes")) choice(*a, "grid axes", {"xy", "xz", "zy", "yz", "zx", "yx"}, c.gridAxes);
+    } else {
+        error(*grid, what + ": grid must be a table { size = [w, h], res = [nx, ny] }, not " + typeName(*grid));
+    }
+    if (const toml::node* n = t.get("density")) number(*n, what + ": density (kg/m²)", c.material.density, 0.0, true);
+    auto p = [&](const char* key, fields::Param& out, const std::string& unit) {
+        if (const toml::node* n = t.get(key))
+            if (auto v = param(*n, what + ": " + key + unit, 1, 0.0)) out = *v;
+    };
+    p("stretch", c.material.stretch, " (N/m)");
+    p("shear", c.material.shear, " (N/m)");
+    p("bend", c.material.bend, " (N·m)");
+    p("damping", c.material.damping, " (s)");
+    c.lift.value = fields::Param(0.3);
+    c.drag.value = fields::Param(1.0);
+    if (const toml::node* n = t.get("lift")) painted(*n, what + ": lift", baseDir, c.lift);
+    if (const toml::node* n = t.get("drag")) painted(*n, what + ": drag", baseDir, c.drag);
+    if (const toml::node* n = t.get("aero_model")) {
+        std::string v;
+        if (choice(*n, "aero_model", {"frozen", "smooth-lift"}, v))
+            c.material.aeroModel = v == "frozen" ? AeroModel::Frozen : AeroModel::SmoothLift;
+    }
+    if (const toml::node* n = t.get("aero_jacobian")) {
+        std::string v;
+        if (choice(*n, "aero_jacobian", {"projected", "paper"}, v))
+            c.step.aeroJacobian = v == "paper" ? AeroJacobian::Paper : AeroJacobian::Projected;
+    }
+    if (const toml::node* n = t.get("pins")) c.hasPins = pins(*n, what + " pins", c.pins);
+    stepOptions(t, what, c.step, c.output);
+}
+
+void Loader::loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h) {
+    h.line = static_cast<int>(t.source().begin.line);
+    h.col = static_cast<int>(t.source().begin.column);
+    h.name = "hair" + std::to_string(index);
+    if (const toml::node* n = t.get("name")) string(*n, "[[hair]] name", h.name);
+    const std::string what = "[[hair]] '" + h.name + "'";
+    checkKeys(t, kHairKeys, "[[hair]]");
+    const toml::node* strands = t.get("strands");
+    const toml::node* grid = t.get("grid");
+    if ((strands != nullptr) == (grid != nullptr)) {
+        error(t, what + " needs exactly one of strands = \"file.ply\" or grid = { size = [w, d], count = [nu, nv], "
+                        "length = L, segments = n }");
+    } else if (strands) {
+        std::string file;
+        if (string(*strands, what + ": strands", file))
+            h.strandsPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    } else if (const toml::table* g = grid->as_table()) {
+        checkKeys(*g, {"size", "count", "length", "segments", "origin", "direction"}, what + " grid");
+        std::vector<double> v;
+        if (const toml::node* s = g->get("size"))
+            if (numbers(*s, what + ": grid size", 2, v)) {
+                h.gridSize[0] = v[0];
+                h.gridSize[1] = v[1];
+            }
+        if (const toml::node* r = g->get("count")) {
+            const toml::array* a = r->as_array();
+            if (!a || a->size() != 2) {
+                error(*r, what + ": grid count must be [nu, nv] (strands along each side)");
+            } else {
+                for (int k = 0; k < 2; ++k) {
+                    long long x = 0;
+                    if (integer(*a->get(k), what + ": grid count", x, 1)) h.gridCount[k] = static_cast<int>(std::min(x, 4096LL));
+                }
+            }
+        }
+        if (const toml::node* n = g->get("length")) number(*n, what + ": grid length (m)", h.length, 0.0, true);
+        if (const toml::node* n = g->get("segments")) {
+            long long x = 0;
+            if (integer(*n, what + ": grid segments", x, 1)) h.segments = static_cast<int>(std::min(x, 100000LL));
+        }
+        if (const toml::node* o = g->get("origin")) vec3(*o, what + ": grid origin", h.origin);
+        if (const toml::node* d = g->get("direction"))
+            if (vec3(*d, what + ": grid direction", h.direction) && h.direction.norm() == 0.0)
+                error(*d, what + ": grid direction must not be zero");
+    } else {
+        error(*grid, what + ": grid must be a table, not " + typeName(*grid));
+    }
+    if (const toml::node* n = t.get("radius")) number(*n, what + ": radius (m)", h.material.radius, 0.0, true);
+    if (const toml::node* n = t.get("density")) number(*n, what + ": density (kg/m³)", h.material.density, 0.0, true);
+    auto p = [&](const char* key, fields::Param& out, const std::string& unit) {
+        if (const toml::node* n = t.get(key))
+            if (auto v = param(*n, what + ": " + key + unit, 1, 0.0)) out = *v;
+    };
+    p("stretch", h.material.stretch, " (EA, N)");
+    p("bend", h.material.bend, " (EI, N·m²)");
+    p("damping", h.material.damping, " (s)");
+    h.dragNormal.value = fields::Param(1.2);
+    h.dragTangent.value = fields::Param(0.05);
+    if (const toml::node* n = t.get("drag_normal")) painted(*n, what + ": drag_normal", baseDir, h.dragNormal);
+    if (const toml::node* n = t.get("drag_tangent")) painted(*n, what + ": drag_tangent", baseDir, h.dragTangent);
+    if (const toml::node* n = t.get("root_pinned")) boolean(*n, what + ": root_pinned", h.material.rootPinned);
+    if (const toml::node* n = t.get("pins"))
+        error(*n, what + ": strands are pinned at their roots (root_pinned = true); pins maps are for cloth");
+    stepOptions(t, what, h.step, h.output);
+}
+
+void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
+    c.name = "collider" + std::to_string(index);
+    if (const toml::node* n = t.get("name")) string(*n, "[[collider]] name", c.name);
+    const std::string what = "[[collider]] '" + c.name + "'";
+    checkKeys(t, kColliderKeys, "[[collider]]");
+    std::string type;
+    const toml::node* tn = t.get("type");
+    if (!tn) {
+        error(t, what + " needs type = \"plane\" | \"sphere\" | \"capsule\"");
+        return;
+    }
+    if (!choice(*tn, "collider type", {"plane", "sphere", "capsule", "mesh"}, type)) return;
+    if (type == "mesh") {
+        error(*tn, what + ": mesh colliders (SDF via OpenVDB) are not available yet; use plane, sphere or capsule");
+        return;
+    }
+    c.shape = type == "plane" ? ColliderShape::Plane : type == "sphere" ? ColliderShape::Sphere : ColliderShape::Capsule;
+    const std::vector<std::string> need = type == "plane"    ? std::vector<std::string>{"point", "normal"}
+                                          : type == "sphere" ? std::vector<std::string>{"center", "radius"}
+                                                             : std::vector<std::string>{"a", "b", "radius"};
+    std::vector<std::string> allowed = {"name", "type", "thickness", "friction"};
+    allowed.insert(allowed.end(), need.begin(), need.end());
+    for (auto&& [key, node] : t) {
+        const std::string k(key.str());
+        if (std::find(allowed.begin(), allowed.end(), k) == allowed.end() &&
+            std::find(kColliderKeys.begin(), kColliderKeys.end(), k) != kColliderKeys.end())
+            error(key.source(), "'" + k + "' does not apply to a " + type + " collider (it takes " + joinNames(need) + ")");
+    }
+    for (const std::string& k : need)
+        if (!t.get(k)) error(t, what + ": a " + type + " collider needs '" + k + "'");
+    auto vecParam = [&](const char* key, fields::Param& out) {
+        if (const toml::node* n = t.get(key))
+            if (auto v = param(*n, what + ": " + key, 3, -1e300)) out = *v;
+    };
+    vecParam("point", c.a);
+    vecParam("center", c.a);
+    vecParam("a", c.a);
+    vecParam("b", c.b);
+    vecParam("normal", c.normal);
+    if (const toml::node* n = t.get("radius")) number(*n, what + ": radius (m)", c.radius, 0.0, true);
+    if (const toml::node* n = t.get("thickness")) number(*n, what + ": thickness (m)", c.thickness, 0.0, false);
+    if (const toml::node* n = t.get("friction")) number(*n, what + ": friction", c.friction, 0.0, false);
+}
+
+void Loader::loadSolver(const toml::table& t, SolverSection& s) {
+    checkKeys(t, kSolverKeys, "[solver]");
+    if (const toml::node* n = t.get("max_halvings")) {
+        long long v = 0;
+        if (integer(*n, "[solver] max_halvings", v, 0)) s.maxHalvings = static_cast<int>(std::min(v, 20LL));
+    }
+    if (const toml::node* n = t.get("over_stretch")) number(*n, "[solver] over_stretch", s.overStretch, 1.0, true);
+    if (const toml::node* n = t.get("velocity_jump")) number(*n, "[solver] velocity_jump (m/s)", s.velocityJump, 0.0, true);
+}
+
+void Loader::load(const toml::table& root, const std::string& baseDir, SimScene& out) {
+    std::set<std::string> names;
+    auto unique = [&](const std::string& name, const toml::node& at, const char* kind) {
+        if (!names.insert(name).second)
+            error(at, "two objects are named '" + name + "' (" + kind + "): object names must be unique, "
+                                                                    "they name the output files");
+    };
+    auto list = [&](const char* key, auto&& each) {
+        const toml::node* n = root.get(key);
+        if (!n) return;
+        const toml::array* a = n->as_array();
+        if (!a || !a->is_array_of_tables()) {
+            error(*n, std::string("'") + key + "' must be an array of tables: write [[" + key + "]] sections");
+            return;
+        }
+        for (size_t i = 0; i < a->size(); ++i) each(*a->get(i)->as_table(), i);
+    };
+    list("cloth", [&](const toml::table& t, size_t i) {
+        ClothSpec c;
+        loadCloth(t, i, baseDir, c);
+        unique(c.name, t, "cloth");
+        out.cloths.push_back(std::move(c));
+    });
+    list("hair", [&](const toml::table& t, size_t i) {
+        HairSpec h;
+        loadHair(t, i, baseDir, h);
+        unique(h.name, t, "hair");
+        out.hairs.push_back(std::move(h));
+    });
+    list("collider", [&](const toml::table& t, size_t i) {
+        Collider c;
+        loadCollider(t, i, c);
+        out.colliders.push_back(std::move(c));
+    });
+    if (const toml::node* n = root.get("solver")) {
+        if (const toml::table* t = n->as_table())
+            loadSolver(*t, out.solver);
+        else
+            error(*n, "'solver' must be a table: write a [solver] section");
+    }
+}
+
+} // namespace
+
+bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
+                  const std::vector<std::string>& sets) {
+    out = SimScene{};
+    fields::SceneLoadOptions options;
+    options.sets = sets;
+    options.foreignSections = {"cloth", "hair", "collider", "solver"};
+    const size_t before = errors.size();
+    const bool windOk = fields::loadScene(path, out.wind, errors, options);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false; // loadScene reported it
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    toml::table root;
+    try {
+        root = toml::parse(text, path);
+    } catch (const toml::parse_error&) {
+        return false; // loadScene reported the syntax error
+    }
+    const size_t mine = errors.size();
+    Loader loader(path, text, errors);
+    loader.applySets(root, sets);
+    const std::string baseDir = std::filesystem::path(path).parent_path().string();
+    loader.load(root, baseDir.empty() ? std::string(".") : baseDir, out);
+    (void)before;
+    return windOk && errors.size() == mine;
+}
+
+} // namespace gale::solver

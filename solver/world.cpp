@@ -1,0 +1,221 @@
+// Frame stepping with substep halving (as production cloth solvers do on trouble), per-frame
+// statistics, and the binary state used by `gale sim --resume`.
+#include "solver/world.h"
+
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+namespace gale::solver {
+
+struct World::Arena {
+    tbb::task_arena arena;
+    explicit Arena(int threads) : arena(threads) {}
+};
+
+World::World(WorldSettings settings) : mSettings(std::move(settings)) {
+    int threads = mSettings.threads;
+    if (threads <= 0) threads = tbb::info::default_concurrency();
+    mSettings.threads = threads;
+    mArena = std::make_unique<Arena>(threads);
+}
+
+World::~World() = default;
+
+FrameStats World::advanceFrame(int frame) {
+    FrameStats fs = advance((frame - 1) / mSettings.fps, 1.0 / mSettings.fps, mSettings.substeps);
+    fs.frame = frame;
+    return fs;
+}
+
+FrameStats World::advance(double t0, double dt, int substeps) {
+    FrameStats fs;
+    fs.time = t0 + dt;
+    const auto start = std::chrono::steady_clock::now();
+    fs.bodies.resize(mBodies.size());
+    mArena->arena.execute([&] {
+        for (size_t b = 0; b < mBodies.size(); ++b) {
+            advanceBody(*mBodies[b], t0, dt, std::max(substeps, 1), fs.bodies[b]);
+            fs.failed = fs.failed || fs.bodies[b].failed;
+        }
+    });
+    fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return fs;
+}
+
+void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats) {
+    stats.name = body.name();
+    const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
+    const long ticksPerBase = 1L << maxLevel;
+    const long totalTicks = ticksPerBase * substeps;
+    const double hBase = dt / substeps;
+    Environment env;
+    env.wind = mWind.get();
+    env.airDensity = mSettings.airDensity;
+    env.gravity = mSettings.gravity;
+    env.colliders = &mColliders;
+    env.fps = mSettings.fps;
+    env.threads = mSettings.threads;
+    long tick = 0;
+    int level = 0;
+    int index = 0;
+    char buf[512];
+    while (tick < totalTicks) {
+        const double h = hBase / static_cast<double>(1L << level);
+        const double t = t0 + hBase * (static_cast<double>(tick) / static_cast<double>(ticksPerBase));
+        env.substepIndex = index;
+        const Body::Snapshot snap = body.snapshot();
+        const SubstepStatus st = body.substep(env, t, h);
+        stats.iterations += st.iterations;
+        stats.maxIterations = std::max(stats.maxIterations, st.iterations);
+        stats.maxResidual = std::max(stats.maxResidual, st.residual);
+        stats.clampedJacobians += st.clampedJacobians;
+        if (st.windNonFinite) {
+            if (stats.windNonFinite == 0) {
+                std::snprintf(buf, sizeof buf, "t=%.6g s: wind: %s", t, st.windMessage.c_str());
+                stats.events.push_back(buf);
+            }
+            stats.windNonFinite += st.windNonFinite;
+        }
+        bool accept = st.trouble == Trouble::None;
+        if (!accept) {
+            if (level < maxLevel) {
+                body.restore(snap);
+                ++level;
+                ++stats.rejected;
+                stats.deepestHalving = std::max(stats.deepestHalving, level);
+                std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep halved to %.6g s", t,
+                              troubleName(st.trouble), st.reason.c_str(), hBase / (1L << level));
+                stats.events.push_back(buf);
+                continue;
+            }
+            if (st.trouble == Trouble::NonFinite) {
+                body.restore(snap);
+                stats.failed = true;
+                std::snprintf(buf, sizeof buf,
+                              "t=%.6g s: %s (%s) at the smallest substep %.6g s; run failed", t,
+                              troubleName(st.trouble), st.reason.c_str(), h);
+                stats.events.push_back(buf);
+                break;
+            }
+            std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s) at the smallest substep %.6g s; accepted",
+                          t, troubleName(st.trouble), st.reason.c_str(), h);
+            stats.events.push_back(buf);
+            accept = true;
+        }
+        tick += ticksPerBase >> level;
+        stats.contacts = st.contacts;
+        ++stats.substeps;
+        ++index;
+    }
+    stats.maxSpeed = 0.0;
+    const VecX& v = body.velocities();
+    for (size_t i = 0; i < body.vertexCount(); ++i)
+        stats.maxSpeed = std::max(stats.maxSpeed, vec3At(v.data(), i).norm());
+    stats.maxStretch = body.maxEdgeStretch();
+    stats.kinetic = body.kineticEnergy();
+    stats.potential = body.potentialEnergy(mSettings.gravity);
+    stats.elastic = body.elasticEnergy(t0 + dt);
+}
+
+// ---- state bytes: "GALESTATE" v1, then per body: name, vertex count, x, v, Δv guess, h guess.
+
+namespace {
+void putU64(std::string& s, uint64_t v) { s.append(reinterpret_cast<const char*>(&v), 8); }
+void putVec(std::string& s, const VecX& v) {
+    putU64(s, static_cast<uint64_t>(v.size()));
+    s.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
+}
+struct Reader {
+    const std::string& s;
+    size_t pos = 0;
+    bool ok = true;
+    uint64_t u64() {
+        uint64_t v = 0;
+        if (pos + 8 > s.size()) {
+            ok = false;
+            return 0;
+        }
+        std::memcpy(&v, s.data() + pos, 8);
+        pos += 8;
+        return v;
+    }
+    VecX vec() {
+        const uint64_t n = u64();
+        if (!ok || n > (s.size() - pos) / sizeof(double)) {
+            ok = false;
+            return VecX();
+        }
+        VecX v(static_cast<long>(n));
+        std::memcpy(v.data(), s.data() + pos, sizeof(double) * n);
+        pos += sizeof(double) * n;
+        return v;
+    }
+};
+} // namespace
+
+std::string World::saveState() const {
+    std::string s = "GALESTATE1";
+    putU64(s, mBodies.size());
+    for (const auto& b : mBodies) {
+        putU64(s, b->name().size());
+        s += b->name();
+        const Body::Snapshot snap = b->snapshot();
+        putVec(s, snap.x);
+        putVec(s, snap.v);
+        putVec(s, snap.dvGuess);
+        double h = snap.hGuess;
+        s.append(reinterpret_cast<const char*>(&h), sizeof h);
+    }
+    return s;
+}
+
+bool World::loadState(const std::string& bytes, std::string& error) {
+    if (bytes.compare(0, 10, "GALESTATE1") != 0) {
+        error = "not a gale solver state (bad header)";
+        return false;
+    }
+    Reader r{bytes, 10};
+    const uint64_t count = r.u64();
+    if (!r.ok || count != mBodies.size()) {
+        error = "the state holds a different number of objects than the scene";
+        return false;
+    }
+    std::vector<Body::Snapshot> snaps(count);
+    for (uint64_t i = 0; i < count; ++i) {
+        const uint64_t len = r.u64();
+        if (!r.ok || r.pos + len > bytes.size()) {
+            error = "truncated state";
+            return false;
+        }
+        const std::string name = bytes.substr(r.pos, len);
+        r.pos += len;
+        if (name != mBodies[i]->name()) {
+            error = "the state's object '" + name + "' does not match the scene's '" +
+                    mBodies[i]->name() + "'";
+            return false;
+        }
+        snaps[i].x = r.vec();
+        snaps[i].v = r.vec();
+        snaps[i].dvGuess = r.vec();
+        if (r.pos + sizeof(double) > bytes.size()) r.ok = false;
+        if (r.ok) {
+            std::memcpy(&snaps[i].hGuess, bytes.data() + r.pos, sizeof(double));
+            r.pos += sizeof(double);
+        }
+        const long n3 = static_cast<long>(3 * mBodies[i]->vertexCount());
+        if (!r.ok || snaps[i].x.size() != n3 || snaps[i].v.size() != n3) {
+            error = "the state of '" + name + "' does not match its vertex count";
+            return false;
+        }
+    }
+    for (uint64_t i = 0; i < count; ++i) mBodies[i]->restore(snaps[i]);
+    return true;
+}
+
+} // namespace gale::solver

@@ -1,0 +1,87 @@
+// A simulation: bodies, colliders and the summed wind, advanced frame by frame with robust
+// substepping — a substep in trouble (non-finite state, the linear solver not converging,
+// over-stretch, a velocity jump) is undone and retried at half the step, the reason logged.
+#pragma once
+
+#include "fields/field.h"
+#include "solver/body.h"
+#include "solver/collider.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+struct WorldSettings {
+    double fps = 24.0;
+    int substeps = 4;      // per frame, the minimum
+    int maxHalvings = 6;   // a substep may be split down to 1/2⁶ of its size
+    Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+    double airDensity = 1.225; // kg/m³
+    int threads = 1;       // 0: all hardware threads; results do not depend on it
+};
+
+// Per body, per frame.
+struct BodyFrameStats {
+    std::string name;
+    int substeps = 0;        // accepted substeps
+    int rejected = 0;        // substeps undone and retried at half the step
+    int deepestHalving = 0;  // 0: every substep at the base size
+    long iterations = 0;     // linear-solver iterations, summed over substeps
+    int maxIterations = 0;   // the most in one substep
+    double maxResidual = 0.0;
+    double maxSpeed = 0.0;   // m/s at the end of the frame
+    double maxStretch = 0.0; // edge length / rest length at the end of the frame
+    double kinetic = 0.0, elastic = 0.0, potential = 0.0; // J, end of frame
+    size_t windNonFinite = 0;
+    int clampedJacobians = 0;
+    int contacts = 0;        // vertices touching colliders at the end of the frame
+    std::vector<std::string> events; // substep halvings and recoveries, with reasons
+    bool failed = false;     // non-finite state that halving could not fix (state restored)
+};
+
+struct FrameStats {
+    int frame = 0;
+    double time = 0.0;        // seconds at the end of the frame
+    double wallSeconds = 0.0;
+    std::vector<BodyFrameStats> bodies;
+    bool failed = false;
+};
+
+class World {
+public:
+    explicit World(WorldSettings settings);
+    ~World();
+
+    const WorldSettings& settings() const { return mSettings; }
+    void setWind(fields::FieldPtr wind) { mWind = std::move(wind); }
+    const fields::FieldPtr& wind() const { return mWind; }
+    void addBody(std::unique_ptr<Body> body) { mBodies.push_back(std::move(body)); }
+    void addCollider(Collider c) { mColliders.push_back(std::move(c)); }
+    const std::vector<std::unique_ptr<Body>>& bodies() const { return mBodies; }
+    Body& body(size_t i) { return *mBodies[i]; }
+    const std::vector<Collider>& colliders() const { return mColliders; }
+
+    // Advances every body from frame − 1 to `frame` (times (frame − 1)/fps → frame/fps).
+    FrameStats advanceFrame(int frame);
+    // Advances by one interval [t0, t0 + dt] split into `substeps` base substeps.
+    FrameStats advance(double t0, double dt, int substeps);
+
+    // The complete state (positions, velocities, warm starts) as bytes, and back: a run
+    // resumed from it continues bit for bit. Returns false with `error` on a mismatch.
+    std::string saveState() const;
+    bool loadState(const std::string& bytes, std::string& error);
+
+private:
+    void advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats);
+
+    WorldSettings mSettings;
+    fields::FieldPtr mWind;
+    std::vector<std::unique_ptr<Body>> mBodies;
+    std::vector<Collider> mColliders;
+    struct Arena;
+    std::unique_ptr<Arena> mArena;
+};
+
+} // namespace gale::solver
