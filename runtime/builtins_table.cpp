@@ -10,6 +10,7 @@ std::shared_ptr<const FunctionTable> FunctionTable::standard() {
         addMathBuiltins(*t);
         addCurveBuiltins(*t);
         addStringBuiltins(*t);
+        addNoiseBuiltins(*t);
         return std::shared_ptr<const FunctionTable>(std::move(t));
     }();
     return table;

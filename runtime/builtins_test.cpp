@@ -51,6 +51,19 @@ TEST_CASE("standard table: every signature parses, names are unique, kernels exi
     CHECK(table.get() == FunctionTable::standard().get());
 }
 
+TEST_CASE("standard table: the language's noise built-ins are all there", "[builtins]") {
+    // language.md's noise family, plus the curl and flow extensions.
+    const char* expected[] = {"snoise", "noise", "vnoise", "cnoise", "snoise4", "vnoise4", "cnoise4", "fbm", "vfbm",
+                              "cfbm", "fbm4", "vfbm4", "cfbm4", "turbulence", "vturbulence", "cturbulence",
+                              "cellnoise", "ccellnoise", "pnoise", "hash", "voronoi", "cvoronoi", "pvoronoi",
+                              "curlnoise", "curlnoise4", "flownoise"};
+    const auto& table = FunctionTable::standard();
+    for (const char* name : expected) {
+        INFO(name);
+        CHECK(table->findFunction(name, nullptr) != nullptr);
+    }
+}
+
 TEST_CASE("standard table: the language's non-noise built-ins are all there", "[builtins]") {
     const char* expected[] = {
         "abs", "acos", "asin", "atan", "atan2", "ceil", "cos", "cosh", "exp", "floor", "fmod", "log", "log10", "pow",

@@ -11,10 +11,11 @@
 #define GALE_NOISE_INLINE inline __attribute__((always_inline))
 
 // Lane loops must be if-converted to vectorise, and at baseline SSE2 GCC will not speculate a
-// float operation that "could trap". Results do not change: this only drops the assumption
-// that FP exceptions are observable (no reassociation, no contraction, NaN and signed zeros
-// kept). Every noise*.cpp includes this header after its standard headers and calls no std::
-// function in lane code (GCC will not inline those across the option change).
+// float operation that "could trap". The project builds with -fno-trapping-math; the pragma
+// keeps the noise loops vectorised whatever the flags. Results do not change: it only drops the
+// assumption that FP exceptions are observable (no reassociation, no contraction, NaN and
+// signed zeros kept). Every noise*.cpp includes this header after its standard headers and calls
+// no std:: function in lane code (GCC will not inline those across an option change).
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("no-trapping-math")
 #endif
@@ -26,7 +27,7 @@
 #define GALE_NOISE_X86 1
 #define GALE_NOISE_SSE42 __attribute__((target("sse4.2,popcnt")))
 #define GALE_NOISE_AVX2 __attribute__((target("avx2")))
-#define GALE_NOISE_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
+#define GALE_NOISE_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=512")))
 #define GALE_NOISE_DISPATCH(Name, Params, Args)                                                   \
     template <class T>                                                                            \
     GALE_NOISE_AVX512 void Name##Avx512 Params {                                                  \
@@ -164,25 +165,6 @@ GALE_NOISE_INLINE T cellValue(int32_t x, int32_t y, int32_t z, uint32_t seed) {
     return unitFromHash<T>(mixStrong(h));
 }
 
-// 3D gradients: the 12 vertices of an icosahedron, cyclic permutations of (0, ±1, ±phi). They
-// form a spherical 5-design, so second and fourth moments are isotropic (unlike the cube-edge
-// set of improved Perlin noise). Bits 16..31 pick the permutation, bits 0 and 1 the signs.
-GALE_NOISE_INLINE uint32_t perm3(uint32_t h) {
-    const uint32_t r = h >> 16;
-    return (r + (r << 1)) >> 16; // floor(3 r / 2^16): 0, 1 or 2
-}
-
-// g . (dx, dy, dz) = ±a ± phi b with (a, b) = (dy, dz), (dx, dy) or (dz, dx).
-template <class T>
-GALE_NOISE_INLINE T dot3(uint32_t h, T dx, T dy, T dz) {
-    const uint32_t sel = perm3(h);
-    T a = sel == 0 ? dy : (sel == 1 ? dx : dz);
-    T b = sel == 0 ? dz : (sel == 1 ? dy : dx);
-    a = static_cast<int32_t>(h << 31) < 0 ? -a : a; // sign-bit tests: a blend mask, no compare
-    b = static_cast<int32_t>(h << 30) < 0 ? -b : b;
-    return a + T(kPhi) * b;
-}
-
 // Bit patterns of T (uint32_t for float, uint64_t for double), for building values from
 // masks without selects whose arms are constants.
 template <class T>
@@ -224,12 +206,41 @@ GALE_NOISE_INLINE typename BitsOf<T>::U signedBits(T v, uint32_t h, int bit) {
     return bitsOf(v) | (static_cast<U>((h >> bit) & 1u) << (8 * sizeof(U) - 1));
 }
 
-// The gradient vector dot3 uses (for analytic derivatives), built from bit masks.
+// 3D gradients: the 12 vertices of an icosahedron, cyclic permutations of (0, ±1, ±phi). They
+// form a spherical 5-design, so second and fourth moments are isotropic (unlike the cube-edge
+// set of improved Perlin noise). The permutation is floor(3 r / 2^16) with r = bits 16..31 of
+// the hash (equal odds), bits 0 and 1 give the signs. Masks of the permutation (all ones where
+// it is 0, 1, 2), found by comparing r with 2^16/3 and 2^17/3:
+template <class T>
+GALE_NOISE_INLINE void perm3Masks(uint32_t h, typename BitsOf<T>::U& m0, typename BitsOf<T>::U& m1,
+                                  typename BitsOf<T>::U& m2) {
+    const int32_t r = static_cast<int32_t>(h >> 16);
+    m0 = maskIf<T>(r < 21846);
+    m2 = maskIf<T>(r > 43690);
+    m1 = ~(m0 | m2);
+}
+
+// g . (dx, dy, dz) = ±a ± phi b with (a, b) = (dy, dz), (dx, dy) or (dz, dx): selects and sign
+// flips as bit operations (cheaper than blends at SSE2 and AVX2).
+template <class T>
+GALE_NOISE_INLINE T dot3(uint32_t h, T dx, T dy, T dz) {
+    using U = typename BitsOf<T>::U;
+    U m0, m1, m2;
+    perm3Masks<T>(h, m0, m1, m2);
+    const U bx = bitsOf(dx), by = bitsOf(dy), bz = bitsOf(dz);
+    constexpr int top = 8 * sizeof(U) - 1;
+    const U sa = static_cast<U>(h & 1u) << top, sb = static_cast<U>((h >> 1) & 1u) << top;
+    const U a = ((by & m0) | (bx & m1) | (bz & m2)) ^ sa;
+    const U b = ((bz & m0) | (by & m1) | (bx & m2)) ^ sb;
+    return fromBits<T>(a) + T(kPhi) * fromBits<T>(b);
+}
+
+// The gradient vector dot3 uses (for analytic derivatives), built from the same masks.
 template <class T>
 GALE_NOISE_INLINE void grad3(uint32_t h, T& gx, T& gy, T& gz) {
     using U = typename BitsOf<T>::U;
-    const uint32_t sel = perm3(h);
-    const U m0 = maskIf<T>(sel == 0), m1 = maskIf<T>(sel == 1), m2 = maskIf<T>(sel == 2);
+    U m0, m1, m2;
+    perm3Masks<T>(h, m0, m1, m2);
     const U v1 = signedBits(T(1), h, 0), v2 = signedBits(T(kPhi), h, 1);
     gx = fromBits<T>((m1 & v1) | (m2 & v2));
     gy = fromBits<T>((m0 & v1) | (m1 & v2));

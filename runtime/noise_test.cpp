@@ -673,6 +673,31 @@ TEST_CASE("NaN coordinates give NaN; huge coordinates stay finite", "[noise]") {
 
 // ---- End to end: signatures, mappings, threads ------------------------------------------------
 
+TEST_CASE("the noise table: every name of the family, parsed signatures, one-line docs", "[noise][builtins]") {
+    FunctionTable t;
+    addNoiseBuiltins(t);
+    const char* names[] = {"snoise", "noise", "vnoise", "cnoise", "snoise4", "vnoise4", "cnoise4", "fbm", "vfbm",
+                           "cfbm", "fbm4", "vfbm4", "cfbm4", "turbulence", "vturbulence", "cturbulence", "cellnoise",
+                           "ccellnoise", "pnoise", "hash", "voronoi", "cvoronoi", "pvoronoi", "curlnoise",
+                           "curlnoise4", "flownoise"};
+    CHECK(t.size() == sizeof(names) / sizeof(names[0]));
+    for (const char* name : names) {
+        INFO(name);
+        int32_t index = -1;
+        REQUIRE(t.findFunction(name, &index) != nullptr);
+        const Builtin& b = t.at(index);
+        lang::ParsedSignature sig;
+        std::string error;
+        CHECK(lang::parseSignature(b.info.signature, sig, &error));
+        for (const auto& p : sig.params) CHECK(!p.name.empty());
+        CHECK(!b.info.doc.empty());
+        CHECK(b.info.doc.find('\n') == std::string_view::npos);
+        CHECK(b.kernelF != nullptr);
+        CHECK(b.kernelD != nullptr);
+        CHECK(b.info.foldable);
+    }
+}
+
 TEST_CASE("the noise family compiles with SeExpr2's signatures and defaults", "[noise][builtins]") {
     const char* ok[] = {"snoise($P)", "noise($P)", "noise($P[0], $P[1])", "noise(1, 2, 3)", "noise(1, 2, 3, 4)",
                         "noise(0.5)", "vnoise($P)", "cnoise($P)", "snoise4($P, $t)", "vnoise4($P, $t)",
