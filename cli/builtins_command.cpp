@@ -2,6 +2,7 @@
 // the same table the compiler type-checks against (aligned text, or JSON).
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "fields/expression_field.h"
 #include "runtime/builtins.h"
 
 #include <CLI/CLI.hpp>
@@ -13,7 +14,8 @@
 namespace gale::cli {
 
 int runBuiltins(const BuiltinsOptions& o) {
-    std::shared_ptr<const runtime::FunctionTable> table = runtime::FunctionTable::standard();
+    // Every function an expression can call: the language's built-ins and the field layer's.
+    std::shared_ptr<const runtime::FunctionTable> table = fields::fieldFunctions();
     const std::vector<runtime::Builtin>& all = table->all();
     std::string out;
     if (o.json) {

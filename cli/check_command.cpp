@@ -19,7 +19,8 @@ namespace {
 
 // Loads a scene (with --set applied by dotted path) and compiles every field; returns an exit
 // code after printing every problem.
-int checkScene(const std::string& path, const std::vector<std::string>& sets) {
+int checkScene(const std::string& path, const std::vector<std::string>& sets,
+               const std::vector<std::string>& allowPaths) {
     fields::Scene scene;
     std::vector<fields::SceneError> errors;
     fields::SceneLoadOptions options;
@@ -35,7 +36,7 @@ int checkScene(const std::string& path, const std::vector<std::string>& sets) {
     }
     std::string report;
     fields::FieldPtr field =
-        fields::buildSceneField(scene, runtime::Precision::Float, report, useColor());
+        fields::buildSceneField(scene, runtime::Precision::Float, report, useColor(), allowPaths);
     if (!report.empty()) std::cerr << report << std::flush;
     return field ? kExitOk : kExitInput;
 }
@@ -64,7 +65,7 @@ int runCheck(const CheckOptions& options) {
     bool sawError = false, sawIoError = false;
     auto checkOne = [&](const std::string& file, const std::string& expr) {
         if (expr.empty() && isSceneFile(file)) {
-            const int rc = checkScene(file, options.sets);
+            const int rc = checkScene(file, options.sets, options.allowPaths);
             if (rc == kExitIo) sawIoError = true;
             if (rc != kExitOk) sawError = true;
             return;
@@ -77,7 +78,9 @@ int runCheck(const CheckOptions& options) {
         Bindings local = bindings;
         const lang::SourceFile compiled = bindParameters(source, local);
         local.addSets(sets);
-        if (!compileAndReport(compiled, local.variables(), wantWidthFor(options.type), &source))
+        const fields::FileAccess files = fields::fileAccessFor(file, options.allowPaths);
+        if (!compileAndReport(compiled, local.variables(), wantWidthFor(options.type), &source,
+                              &files))
             sawError = true;
     };
     for (const std::string& file : options.files) checkOne(file, "");
@@ -113,6 +116,7 @@ Command addCheckCommand(CLI::App& app) {
                     "Declare the columns of this point file (.csv/.ply/.obj) as varying variables, "
                     "as eval --points does")
         ->type_name("IN");
+    addAllowPathOption(*sub, options->allowPaths);
     return {sub, [options] { return runCheck(*options); }};
 }
 

@@ -34,6 +34,9 @@ struct SourceOptions {
     std::string expr;              // -e EXPR
     std::vector<std::string> sets; // --set NAME=VALUE
     std::string type = "auto";     // auto | float | vector
+    // --allow-path DIR: folders files named by expressions may reach besides their own
+    // (docs/geometry.md).
+    std::vector<std::string> allowPaths;
 };
 
 struct CheckOptions {
@@ -42,6 +45,7 @@ struct CheckOptions {
     std::vector<std::string> sets;
     std::string type = "auto";
     std::string points; // declare this point file's columns as variables
+    std::vector<std::string> allowPaths; // --allow-path DIR
 };
 
 struct EvalOptions {
@@ -102,6 +106,12 @@ struct VizOptions {
     double speedMax = 0.0;           // colour scale top in m/s (0: from the slice)
     double arrowSpacing = 0.0;       // pixels between arrows (0: about 22 across)
     int threads = 0;
+    // Preview renders (cli/preview.cpp): frames of a simulation, contact sheets of wedges.
+    std::string frames;              // A:B (per-frame pictures; OUT has '#'), or a list for sheets
+    std::string sim;                 // the gale sim output folder (default "sim")
+    std::string contactSheet;        // a gale wedge output folder
+    bool noField = false;            // a plain backdrop instead of the field slice
+    std::string cell = "240x240";    // contact sheet thumbnail size
 };
 
 int runCheck(const CheckOptions& options);
@@ -118,5 +128,33 @@ Command addBenchCommand(CLI::App& app);
 Command addBuiltinsCommand(CLI::App& app);
 Command addSampleCommand(CLI::App& app);
 Command addVizCommand(CLI::App& app);
+
+// `gale sim SCENE.toml`: cloth and hair driven by the scene's wind (cli/sim_command.cpp).
+struct SimOptions {
+    std::string scene;
+    std::string output = "sim";    // OUTDIR
+    std::string frames;            // A:B (empty: the scene's frames)
+    std::vector<std::string> sets; // --set KEY=VALUE by dotted scene path
+    bool resume = false;
+    int threads = 1;               // 0: all hardware threads; results do not depend on it
+    bool json = false;             // print run.json's content to stdout at the end
+    std::vector<std::string> allowPaths; // --allow-path DIR (files named by expressions)
+};
+int runSim(const SimOptions& options);
+Command addSimCommand(CLI::App& app);
+
+// `gale wedge SCENE.toml --vary KEY=V1,V2,... -o OUTDIR` (cli/wedge_command.cpp).
+struct WedgeOptions {
+    std::string scene;
+    std::vector<std::string> vary; // KEY=V1,V2,...
+    std::vector<std::string> sets; // --set KEY=VALUE in every variant
+    std::string frames;            // A:B in every variant (empty: the scene's)
+    std::string output;            // OUTDIR
+    int jobs = 1;                  // variants run at once locally
+    bool emitOnly = false;
+    int threads = 1;               // each simulation's --threads
+};
+int runWedge(const WedgeOptions& options);
+Command addWedgeCommand(CLI::App& app);
 
 } // namespace gale::cli

@@ -248,11 +248,11 @@ void Bindings::fillRequest(runtime::EvalRequest& request) const {
 
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth, const lang::SourceFile* shown) {
+                 int wantWidth, const lang::SourceFile* shown, const fields::FileAccess* files) {
     runtime::CompileSettings settings;
     settings.variables = variables;
     settings.wantWidth = wantWidth;
-    settings.functions = fields::fieldFunctions();
+    settings.functions = files ? fields::fieldFunctions(*files) : fields::fieldFunctions();
     lang::DiagnosticSink sink;
     std::shared_ptr<const runtime::Program> program =
         runtime::Program::compile(source, settings, sink);
@@ -357,6 +357,16 @@ std::string wrapHelp(const std::string& text, size_t width) {
     return out;
 }
 
+void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths) {
+    app.add_option("--allow-path", allowPaths,
+                   "Let files named by expressions (sdf(\"body.obj\", $P), vdb(...)) come from "
+                   "this folder too; by default they must be inside the folder of the "
+                   "expression or scene file. Repeatable")
+        ->type_name("DIR")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
 void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType) {
     CLI::Option* file =
         app.add_option("file", options.file, "Expression file (.se); '-' reads it from stdin")
@@ -372,6 +382,7 @@ void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType) {
         ->type_name("NAME=VALUE")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    addAllowPathOption(app, options.allowPaths);
     if (withType)
         app.add_option("--type", options.type,
                        "Wanted result: auto keeps the expression's width; float wants FP[1] (a "

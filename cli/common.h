@@ -18,6 +18,10 @@ class App;
 class Option;
 } // namespace CLI
 
+namespace gale::fields {
+struct FileAccess;
+} // namespace gale::fields
+
 namespace gale::cli {
 
 // "gale: <message>" on stderr.
@@ -77,10 +81,15 @@ private:
 
 // Compiles `source` against the field layer's built-ins (the standard ones plus gust, fftturb,
 // ...), printing every diagnostic (errors and warnings) to stderr, rendered against `shown`
-// when given (the text before parameters were blanked). Null on errors.
+// when given (the text before parameters were blanked). File names in the expression (sdf(),
+// vdb(), ...) resolve under `files` (null: the current folder). Null on errors.
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth, const lang::SourceFile* shown = nullptr);
+                 int wantWidth, const lang::SourceFile* shown = nullptr,
+                 const fields::FileAccess* files = nullptr);
+
+// Adds `--allow-path DIR` (repeatable) to a subcommand.
+void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths);
 
 // The parameter idiom (`$speed = 5;  # 0, 40`): binds each declared parameter as a uniform of
 // its default value (a later --set of the same name replaces it) and returns the source with
@@ -103,7 +112,7 @@ std::string jsonString(const std::string& s);
 // Word-wraps help text to `width` columns (CLI11 indents the continuation lines).
 std::string wrapHelp(const std::string& text, size_t width = 62);
 
-// Adds `FILE` / `-e,--expr` / `--set` / `--type` to a subcommand.
+// Adds `FILE` / `-e,--expr` / `--set` / `--type` / `--allow-path` to a subcommand.
 void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType = true);
 
 } // namespace gale::cli

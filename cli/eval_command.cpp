@@ -178,7 +178,7 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
     std::string report;
     fields::FieldPtr field = fields::buildSceneField(
         scene, asFloat ? runtime::Precision::Float : runtime::Precision::Double, report,
-        useColor());
+        useColor(), o.source.allowPaths);
     if (!report.empty()) std::cerr << report << std::flush;
     if (!field) return kExitInput;
 
@@ -275,8 +275,9 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     const lang::SourceFile compiled = bindParameters(source, bindings);
     bindings.addSets(sets);
 
+    const fields::FileAccess files = fields::fileAccessFor(o.source.file, o.source.allowPaths);
     std::shared_ptr<const runtime::Program> program = compileAndReport(
-        compiled, bindings.variables(), wantWidthFor(o.source.type), &source);
+        compiled, bindings.variables(), wantWidthFor(o.source.type), &source, &files);
     if (!program) return kExitInput;
     if (o.disasm) {
         std::cout << program->disassemble() << std::flush;

@@ -67,6 +67,7 @@ int loadExpression(const SourceOptions& source, FieldInput& out) {
     const std::vector<fields::ParameterDecl> declared = fields::findParameters(file);
     fields::ExpressionFieldOptions options;
     options.precision = runtime::Precision::Float;
+    options.files = fields::fileAccessFor(source.file, source.allowPaths);
     std::vector<runtime::UniformValue> extras;
     for (const SetValue& s : sets) {
         const bool isParameter =
@@ -131,7 +132,8 @@ int loadSceneInput(const SourceOptions& source, FieldInput& out) {
     }
     std::string report;
     fields::FieldPtr field =
-        fields::buildSceneField(*scene, runtime::Precision::Float, report, useColor());
+        fields::buildSceneField(*scene, runtime::Precision::Float, report, useColor(),
+                                source.allowPaths);
     if (!report.empty()) std::cerr << report << (report.back() == '\n' ? "" : "\n") << std::flush;
     if (!field) return kExitInput;
     out.name = source.file;

@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
         addBuiltinsCommand(app),
         addSampleCommand(app),
         addVizCommand(app),
+        addSimCommand(app),
+        addWedgeCommand(app),
     };
 
     wrapAllHelp(app);

@@ -128,13 +128,19 @@ public:
         cairo_set_source_rgb(mCr, 1, 1, 1);
         cairo_paint(mCr);
         computeSpeeds();
-        drawTitle();
-        drawRaster();
-        if (mSet.style == FlowStyle::Arrows) drawArrows();
-        if (mSet.style == FlowStyle::Streamlines) drawStreamlines();
-        drawGustBands();
+        if (!mSet.compact) drawTitle();
+        if (mSet.fieldRaster && !mSpeed.empty()) {
+            drawRaster();
+            if (mSet.style == FlowStyle::Arrows) drawArrows();
+            if (mSet.style == FlowStyle::Streamlines) drawStreamlines();
+        } else {
+            drawBackdrop();
+        }
+        if (!mSet.compact) drawGustBands();
+        drawGeometry();
+        if (mSet.compact) return;
         drawAxes();
-        drawColorBar();
+        if (mSet.fieldRaster && !mSpeed.empty()) drawColorBar();
         if (mOver.windicator.present) drawWindicator();
         if (mOver.timeline.present && mL.timeline.h > 0) drawTimeline();
     }
@@ -159,6 +165,7 @@ private:
 
     void computeSpeeds() {
         const size_t n = static_cast<size_t>(mSlice.nu) * static_cast<size_t>(mSlice.nv);
+        if (mSlice.velocity.size() < 3 * n) return; // no field sampled: a backdrop instead
         mSpeed.resize(n);
         mMaxSpeed = 0.0;
         for (size_t i = 0; i < n; ++i) {
@@ -211,6 +218,103 @@ private:
     double spacing() const {
         if (mSet.arrowSpacing > 0) return mSet.arrowSpacing;
         return std::max(26.0 * mS, std::max(mL.plot.w, mL.plot.h) / 22.0);
+    }
+
+    // A soft vertical gradient behind geometry drawn without a field slice.
+    void drawBackdrop() {
+        cairo_pattern_t* g = cairo_pattern_create_linear(0, mL.plot.y, 0, mL.plot.y + mL.plot.h);
+        cairo_pattern_add_color_stop_rgb(g, 0, 0.93, 0.95, 0.97);
+        cairo_pattern_add_color_stop_rgb(g, 1, 0.82, 0.85, 0.89);
+        cairo_rectangle(mCr, mL.plot.x, mL.plot.y, mL.plot.w, mL.plot.h);
+        cairo_set_source(mCr, g);
+        cairo_fill(mCr);
+        cairo_pattern_destroy(g);
+    }
+
+    // Cloth triangles and hair segments, far ones first (painter's algorithm); the viewer looks
+    // along -(u x v), the light comes from the upper left, in front.
+    void drawGeometry() {
+        if (mOver.geometry.empty()) return;
+        const int u = mSlice.uAxis, v = mSlice.vAxis, n = mSlice.normalAxis;
+        const double towardsViewer = (u + 1) % 3 == v ? 1.0 : -1.0;
+        double light[3] = {0, 0, 0};
+        light[u] = -0.45;
+        light[v] = 0.6;
+        light[n] = 0.66 * towardsViewer;
+        const double ll = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+        for (double& c : light) c /= ll;
+        struct Item {
+            double depth;
+            const GeometryOverlay* g;
+            int index;  // triangle, or first point of a segment
+            int second; // -1 for a triangle
+            double shade;
+        };
+        std::vector<Item> items;
+        for (const GeometryOverlay& g : mOver.geometry) {
+            const auto& p = g.points;
+            const int count = static_cast<int>(p.size());
+            for (size_t t = 0; t < g.triangles.size(); ++t) {
+                const auto& tri = g.triangles[t];
+                if (tri[0] < 0 || tri[1] < 0 || tri[2] < 0 || tri[0] >= count || tri[1] >= count || tri[2] >= count)
+                    continue;
+                const auto &a = p[tri[0]], &b = p[tri[1]], &c = p[tri[2]];
+                const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+                const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+                const double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                      e1[0] * e2[1] - e1[1] * e2[0]};
+                const double len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+                if (!(len > 0)) continue;
+                const double shade = std::fabs(nn[0] * light[0] + nn[1] * light[1] + nn[2] * light[2]) / len;
+                items.push_back({towardsViewer * (a[n] + b[n] + c[n]) / 3, &g, static_cast<int>(t), -1, shade});
+            }
+            for (const std::vector<int>& line : g.polylines)
+                for (size_t k = 0; k + 1 < line.size(); ++k) {
+                    const int i = line[k], j = line[k + 1];
+                    if (i < 0 || j < 0 || i >= count || j >= count) continue;
+                    double d[3] = {p[j][0] - p[i][0], p[j][1] - p[i][1], p[j][2] - p[i][2]};
+                    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    const double tl = len > 0 ? (d[0] * light[0] + d[1] * light[1] + d[2] * light[2]) / len : 0;
+                    items.push_back({towardsViewer * (p[i][n] + p[j][n]) / 2, &g, i, j,
+                                     std::sqrt(std::max(0.0, 1 - tl * tl))});
+                }
+        }
+        std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.depth < b.depth; });
+        cairo_save(mCr);
+        clipToPlot();
+        cairo_set_line_join(mCr, CAIRO_LINE_JOIN_ROUND);
+        cairo_set_line_cap(mCr, CAIRO_LINE_CAP_ROUND);
+        const Rgb cloth{0.42, 0.6, 0.86}, hair{0.62, 0.42, 0.2};
+        auto at = [&](const std::array<double, 3>& q, double& x, double& y) {
+            x = pxOfU(q[u]);
+            y = pyOfV(q[v]);
+        };
+        for (const Item& it : items) {
+            const auto& p = it.g->points;
+            const double k = 0.28 + 0.72 * it.shade;
+            double x = 0, y = 0;
+            if (it.second < 0) {
+                const auto& tri = it.g->triangles[static_cast<size_t>(it.index)];
+                for (int c = 0; c < 3; ++c) {
+                    at(p[tri[c]], x, y);
+                    c == 0 ? cairo_move_to(mCr, x, y) : cairo_line_to(mCr, x, y);
+                }
+                cairo_close_path(mCr);
+                setColor(mCr, {cloth.r * k, cloth.g * k, cloth.b * k});
+                cairo_fill_preserve(mCr);
+                cairo_set_line_width(mCr, 0.6);
+                cairo_stroke(mCr);
+            } else {
+                at(p[it.index], x, y);
+                cairo_move_to(mCr, x, y);
+                at(p[it.second], x, y);
+                cairo_line_to(mCr, x, y);
+                setColor(mCr, {hair.r * (0.4 + k), hair.g * (0.4 + k), hair.b * (0.4 + k)});
+                cairo_set_line_width(mCr, std::max(1.0, 1.6 * mS));
+                cairo_stroke(mCr);
+            }
+        }
+        cairo_restore(mCr);
     }
 
     void clipToPlot() {
@@ -839,6 +943,91 @@ fields::IoError renderSlice(const std::string& path, const SliceLayout& layout, 
         const bool closed = std::fclose(sink.f) == 0;
         if (!closed && !sink.err) sink.err = errno;
         if (status != CAIRO_STATUS_SUCCESS || !closed) return cairoError(path, status, sink.err);
+        return {};
+    });
+}
+
+SliceLayout layoutThumbnail(int width, int height, double boundsW, double boundsH) {
+    SliceLayout l;
+    l.width = width;
+    l.height = height;
+    l.scale = 0.6;
+    const double aspect = boundsW > 0 && boundsH > 0 ? boundsW / boundsH : 1.0;
+    double w = width, h = width / aspect;
+    if (h > height) {
+        h = height;
+        w = height * aspect;
+    }
+    l.plotW = std::max(1, static_cast<int>(std::floor(w)));
+    l.plotH = std::max(1, static_cast<int>(std::floor(h)));
+    l.plot = {std::floor((width - l.plotW) / 2.0), std::floor((height - l.plotH) / 2.0),
+              static_cast<double>(l.plotW), static_cast<double>(l.plotH)};
+    return l;
+}
+
+fields::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet) {
+    const int gap = 8, top = 64, head = 22;
+    const int cols = static_cast<int>(sheet.columnHeadings.size());
+    const int rows = static_cast<int>(sheet.rows.size());
+    const int width = sheet.labelW + cols * (sheet.cellW + gap) + gap;
+    const int height = top + head + rows * (sheet.cellH + gap) + gap;
+    std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> image(
+        cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height), cairo_surface_destroy);
+    cairo_t* cr = cairo_create(image.get());
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_paint(cr);
+    setColor(cr, kInk);
+    setFont(cr, 17, Weight::Bold);
+    text(cr, 16, 28, sheet.title);
+    setFont(cr, 13, Weight::Bold);
+    for (int c = 0; c < cols; ++c)
+        text(cr, sheet.labelW + c * (sheet.cellW + gap) + sheet.cellW / 2.0, top + head - 6,
+             sheet.columnHeadings[static_cast<size_t>(c)], 0.5);
+    for (int r = 0; r < rows; ++r) {
+        const double y0 = top + head + r * (sheet.cellH + gap);
+        const auto& labels = r < static_cast<int>(sheet.rowLabels.size()) ? sheet.rowLabels[static_cast<size_t>(r)]
+                                                                          : std::vector<std::string>{};
+        for (size_t k = 0; k < labels.size(); ++k) {
+            setFont(cr, 13, k == 0 ? Weight::Bold : Weight::Normal);
+            setColor(cr, k == 0 ? kInk : kMuted);
+            text(cr, 16, y0 + 20 + 18 * static_cast<double>(k), labels[k]);
+        }
+        const auto& cells = sheet.rows[static_cast<size_t>(r)];
+        for (int c = 0; c < cols && c < static_cast<int>(cells.size()); ++c) {
+            const ContactCell& cell = cells[static_cast<size_t>(c)];
+            const double x0 = sheet.labelW + c * (sheet.cellW + gap);
+            cairo_save(cr);
+            cairo_translate(cr, x0, y0);
+            cairo_rectangle(cr, 0, 0, sheet.cellW, sheet.cellH);
+            cairo_clip(cr);
+            const SliceLayout layout = layoutThumbnail(sheet.cellW, sheet.cellH, cell.slice.bounds[2] - cell.slice.bounds[0],
+                                                       cell.slice.bounds[3] - cell.slice.bounds[1]);
+            Painter(cr, layout, cell.slice, cell.overlays, cell.settings).paint();
+            cairo_restore(cr);
+            cairo_rectangle(cr, x0 + 0.5, y0 + 0.5, sheet.cellW - 1, sheet.cellH - 1);
+            setColor(cr, kMuted, 0.5);
+            cairo_set_line_width(cr, 1);
+            cairo_stroke(cr);
+        }
+    }
+    const cairo_status_t status = cairo_status(cr);
+    cairo_destroy(cr);
+    if (status != CAIRO_STATUS_SUCCESS) {
+        fields::IoError e;
+        e.kind = fields::IoError::Data;
+        e.file = path;
+        e.message = std::string("cannot draw the contact sheet: ") + cairo_status_to_string(status);
+        return e;
+    }
+    return fields::writeFileAtomic(path, [&](const std::string& tmp) -> fields::IoError {
+        FileSink sink;
+        errno = 0;
+        sink.f = std::fopen(tmp.c_str(), "wb");
+        if (!sink.f) return cairoError(path, CAIRO_STATUS_WRITE_ERROR, errno);
+        const cairo_status_t st = cairo_surface_write_to_png_stream(image.get(), writeToFile, &sink);
+        const bool closed = std::fclose(sink.f) == 0;
+        if (!closed && !sink.err) sink.err = errno;
+        if (st != CAIRO_STATUS_SUCCESS || !closed) return cairoError(path, st, sink.err);
         return {};
     });
 }

@@ -73,10 +73,21 @@ struct TimelineOverlay {
     Curve windicatorSpeed;    // empty points: none
 };
 
+// Simulated cloth or hair drawn over the slice (`gale viz --frames`): world positions, triangles
+// (cloth: Lambert-shaded with a fixed light, far ones first) and polylines (hair strands),
+// projected orthographically onto the plot along the slice's normal.
+struct GeometryOverlay {
+    std::string label;
+    std::vector<std::array<double, 3>> points;
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<std::vector<int>> polylines;
+};
+
 struct SliceOverlays {
     WindicatorOverlay windicator;
     std::vector<GustBand> gusts;
     TimelineOverlay timeline;
+    std::vector<GeometryOverlay> geometry;
 };
 
 enum class FlowStyle { Arrows, Streamlines, None };
@@ -89,10 +100,34 @@ struct RenderSettings {
     FlowStyle style = FlowStyle::Arrows;
     double speedMax = 0.0;     // top of the colour scale, m/s (0: a round number above the max)
     double arrowSpacing = 0.0; // pixels between arrows / streamlines (0: about 22 across)
+    bool fieldRaster = true;   // false: a plain backdrop instead of speed colours (no colour bar)
+    bool compact = false;      // a thumbnail: the plot only (no title, axes, legend, rigs)
 };
 
 // Draws the picture and writes it to `path` through a temporary file and a rename.
 fields::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
                             const SliceOverlays& overlays, const RenderSettings& settings);
+
+// One thumbnail of a contact sheet: a picture laid out for the cell (layoutThumbnail).
+struct ContactCell {
+    Slice slice;
+    SliceOverlays overlays;
+    RenderSettings settings; // compact
+};
+
+// A width x height thumbnail layout: the whole cell is plot (keeping the bounds' aspect).
+SliceLayout layoutThumbnail(int width, int height, double boundsW, double boundsH);
+
+// A contact sheet: rows of thumbnails (cellW x cellH each) under column headings, each row
+// with label lines on its left (a wedge variant's values), written as PNG through a rename.
+struct ContactSheet {
+    std::string title;
+    std::vector<std::string> columnHeadings;         // one per column (e.g. "frame 12")
+    std::vector<std::vector<std::string>> rowLabels; // lines per row
+    int cellW = 240, cellH = 240;
+    int labelW = 220;
+    std::vector<std::vector<ContactCell>> rows;      // rows[r][c]
+};
+fields::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet);
 
 } // namespace gale::cli

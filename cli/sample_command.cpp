@@ -232,6 +232,7 @@ Command addSampleCommand(CLI::App& app) {
         ->type_name("NAME=VALUE")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    addAllowPathOption(*sub, o->source.allowPaths);
     sub->add_option("--bounds", o->bounds,
                     "The box to sample, metres: x0,y0,z0,x1,y1,z1; the grid starts at its min "
                     "corner")

@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/field_input.h"
+#include "cli/preview.h"
 #include "cli/render.h"
 #include "fields/grid_sample.h"
 #include "fields/rigs.h"
@@ -18,7 +19,7 @@
 
 namespace gale::cli {
 
-namespace {
+// (The helpers up to sceneOverlays are shared with the preview renders: cli/preview.h.)
 
 // "z=0" -> axis 2, value 0.
 bool parsePlane(const std::string& text, int& axis, double& value, std::string& error) {
@@ -76,7 +77,7 @@ std::string axisName(int a) {
 
 // Samples of a gust's strength * envelope at the origin plane, from just before its start to
 // just after it has died away.
-TimelineOverlay::Curve gustCurve(const fields::Gust& g, const std::string& label) {
+static TimelineOverlay::Curve gustCurve(const fields::Gust& g, const std::string& label) {
     TimelineOverlay::Curve c;
     c.label = label;
     const double total = g.attack + g.hold + g.decay;
@@ -135,9 +136,46 @@ SliceOverlays sceneOverlays(const fields::Scene& scene, double t) {
     return o;
 }
 
-} // namespace
+int sampleSlice(const FieldInput& input, double t, int threads, Slice& slice) {
+    const int uAxis = slice.uAxis, vAxis = slice.vAxis, normal = slice.normalAxis;
+    const std::array<double, 4>& b = slice.bounds;
+    const double planeValue = slice.planeValue;
+    const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
+    std::vector<double> positions(3 * n), velocities(3 * n, 0.0);
+    for (int row = 0; row < slice.nv; ++row)
+        for (int col = 0; col < slice.nu; ++col) {
+            double* p = positions.data() + 3 * (static_cast<size_t>(row) * slice.nu + col);
+            p[uAxis] = b[0] + (col + 0.5) / slice.nu * (b[2] - b[0]);
+            p[vAxis] = b[3] - (row + 0.5) / slice.nv * (b[3] - b[1]);
+            p[normal] = planeValue;
+        }
+    fields::SampleTime when;
+    when.time = t;
+    when.fps = input.fps;
+    when.threads = threads;
+    fields::GridSampleOptions sampling;
+    sampling.threads = threads;
+    fields::SampleStatus status =
+        fields::samplePoints(*input.field, positions.data(), n, when, velocities.data(), sampling);
+    if (!status.ok) {
+        printError("cannot sample " + input.name + ": " + status.message);
+        return kExitInput;
+    }
+    if (status.nonFinite > 0) {
+        printError(std::to_string(status.nonFinite) + " of " + std::to_string(n) +
+                   " sample(s) of " + input.name + " gave a non-finite velocity at t = " +
+                   formatValue(t, false) + " s; no picture was written");
+        return kExitNumeric;
+    }
+    slice.velocity.resize(3 * n);
+    for (size_t i = 0; i < 3 * n; ++i) slice.velocity[i] = static_cast<float>(velocities[i]);
+    return kExitOk;
+}
 
 int runViz(const VizOptions& o) {
+    // Preview renders of simulated frames, and contact sheets of wedges (cli/preview.cpp).
+    if (!o.contactSheet.empty()) return runContactSheet(o);
+    if (!o.frames.empty()) return runVizFrames(o);
     std::string error;
     int normal = 2;
     double planeValue = 0.0;
@@ -146,6 +184,11 @@ int runViz(const VizOptions& o) {
         return kExitUsage;
     }
     std::vector<double> b;
+    if (o.bounds.empty()) {
+        printError("--bounds is required (u0,v0,u1,v1 in the plane's axes), except with --frames or "
+                   "--contact-sheet");
+        return kExitUsage;
+    }
     if (!parseNumbers(o.bounds, 4, "--bounds", b, error)) {
         printError(error + " (u0,v0,u1,v1 in the plane's axes)");
         return kExitUsage;
@@ -197,35 +240,7 @@ int runViz(const VizOptions& o) {
     slice.vAxis = vAxis;
     slice.normalAxis = normal;
     slice.planeValue = planeValue;
-    const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
-    std::vector<double> positions(3 * n), velocities(3 * n, 0.0);
-    for (int row = 0; row < slice.nv; ++row)
-        for (int col = 0; col < slice.nu; ++col) {
-            double* p = positions.data() + 3 * (static_cast<size_t>(row) * slice.nu + col);
-            p[uAxis] = b[0] + (col + 0.5) / slice.nu * (b[2] - b[0]);
-            p[vAxis] = b[3] - (row + 0.5) / slice.nv * (b[3] - b[1]);
-            p[normal] = planeValue;
-        }
-    fields::SampleTime when;
-    when.time = t;
-    when.fps = input.fps;
-    when.threads = o.threads;
-    fields::GridSampleOptions sampling;
-    sampling.threads = o.threads;
-    fields::SampleStatus status =
-        fields::samplePoints(*input.field, positions.data(), n, when, velocities.data(), sampling);
-    if (!status.ok) {
-        printError("cannot sample " + input.name + ": " + status.message);
-        return kExitInput;
-    }
-    if (status.nonFinite > 0) {
-        printError(std::to_string(status.nonFinite) + " of " + std::to_string(n) +
-                   " sample(s) of " + input.name + " gave a non-finite velocity at t = " +
-                   formatValue(t, false) + " s; no picture was written");
-        return kExitNumeric;
-    }
-    slice.velocity.resize(3 * n);
-    for (size_t i = 0; i < 3 * n; ++i) slice.velocity[i] = static_cast<float>(velocities[i]);
+    if (int rc = sampleSlice(input, t, o.threads, slice)) return rc;
 
     RenderSettings settings;
     settings.format = format;
@@ -269,6 +284,7 @@ Command addVizCommand(CLI::App& app) {
         ->type_name("NAME=VALUE")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    addAllowPathOption(*sub, o->source.allowPaths);
     sub->add_option("--plane", o->plane,
                     "The slice: z=C (drawn with x right, y up), y=C (x right, z up) or x=C (z "
                     "right, y up)")
@@ -276,9 +292,9 @@ Command addVizCommand(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--bounds", o->bounds,
                     "The slice's extent in metres along the drawn axes: u0,v0,u1,v1 (for z=C: "
-                    "x0,y0,x1,y1)")
-        ->type_name("BOX")
-        ->required();
+                    "x0,y0,x1,y1). Required, except with --frames (default: around the simulated "
+                    "geometry of every frame) and --contact-sheet")
+        ->type_name("BOX");
     sub->add_option("--time", o->time, "$t in seconds")->capture_default_str()->type_name("T");
     sub->add_option("--fps", o->fps, "Frames per second (default: the scene's, else 24)")
         ->type_name("FPS");
@@ -300,6 +316,24 @@ Command addVizCommand(CLI::App& app) {
     sub->add_option("--arrow-spacing", o->arrowSpacing,
                     "Pixels between arrows or streamlines (default: about 22 across)")
         ->type_name("PX");
+    sub->add_option("--frames", o->frames,
+                    "Preview renders of a scene's simulation: one picture per frame A to B (OUT has a # "
+                    "run for the frame number), drawing the simulated cloth and hair (shaded) over the "
+                    "slice, the windicator with its current speed and the gust timeline. With "
+                    "--contact-sheet: the frames shown, as A:B, A:B:STEP or a list 12,24,48")
+        ->type_name("A:B");
+    sub->add_option("--sim", o->sim, "With --frames: the gale sim output folder holding the frames "
+                                     "(default: sim, gale sim's default)")
+        ->type_name("OUTDIR");
+    sub->add_option("--contact-sheet", o->contactSheet,
+                    "A contact sheet of a gale wedge output folder: one row of thumbnails per variant "
+                    "(labelled with its values), one column per --frames frame; OUT is a .png")
+        ->type_name("WEDGEDIR");
+    sub->add_flag("--no-field", o->noField, "With --frames: a plain backdrop instead of the field slice "
+                                            "(the default for contact sheets)");
+    sub->add_option("--cell", o->cell, "Contact sheet thumbnail size in pixels")
+        ->type_name("WxH")
+        ->capture_default_str();
     sub->add_option("--threads", o->threads, "Threads (default 0 = all hardware threads)")
         ->type_name("N")
         ->check(CLI::Range(0, 4096));

@@ -238,6 +238,7 @@ std::shared_ptr<ExpressionField> ExpressionField::compile(const lang::SourceFile
     settings.functions = options.functions     ? options.functions
                          : options.scene       ? sceneFunctions(*options.scene)
                                                : fieldFunctions();
+    if (options.files) settings.functions = withFileAccess(settings.functions, *options.files);
     field->mOptions.functions = settings.functions;
     const lang::SourceFile blanked = withoutParameters(source, field->mParameters);
     field->mProgram = runtime::Program::compile(blanked, settings, sink);
@@ -350,6 +351,7 @@ std::shared_ptr<const runtime::FunctionTable> fieldFunctions() {
         auto t = std::make_shared<runtime::FunctionTable>(*runtime::FunctionTable::standard());
         addGustBuiltins(*t);
         addTurbulenceBuiltins(*t);
+        addGeometryBuiltins(*t, FileAccess{});
         return std::shared_ptr<const runtime::FunctionTable>(std::move(t));
     }();
     return table;
@@ -409,15 +411,21 @@ bool fieldSource(const Scene& scene, const FieldEntry& entry, lang::SourceFile& 
 }
 
 FieldPtr buildSceneField(const Scene& scene, runtime::Precision precision, std::string& report,
-                         bool color) {
+                         bool color, const std::vector<std::string>& allowPaths) {
     lang::RenderOptions render;
     render.color = color;
     const std::shared_ptr<const runtime::FunctionTable> functions = sceneFunctions(scene);
     std::vector<SumField::Term> terms;
     bool ok = true;
     auto compileOne = [&](const lang::SourceFile& source, const std::map<std::string, Param>& params,
-                          const std::string& name) -> std::shared_ptr<ExpressionField> {
+                          const std::string& name,
+                          const std::string& exprPath) -> std::shared_ptr<ExpressionField> {
         ExpressionFieldOptions options;
+        // Files named by the expression: relative to its file (the scene for inline text),
+        // inside the scene's folder.
+        FileAccess files = fileAccessFor(exprPath.empty() ? scene.path : exprPath, allowPaths);
+        files.rootDir = scene.baseDir.empty() ? "." : scene.baseDir;
+        options.files = files;
         options.params = params;
         options.precision = precision;
         options.scene = &scene;
@@ -442,14 +450,15 @@ FieldPtr buildSceneField(const Scene& scene, runtime::Precision precision, std::
                                            (entry.preset.empty() ? entry.exprPath
                                                                  : "preset " + entry.preset) +
                                            ")";
-        std::shared_ptr<ExpressionField> field = compileOne(source, entry.params, what);
+        std::shared_ptr<ExpressionField> field =
+            compileOne(source, entry.params, what, entry.exprPath);
         std::shared_ptr<ExpressionField> mask;
         if (!entry.mask.empty()) {
             const std::string maskName = entry.maskLine > 0
                                              ? scene.path
                                              : scene.path + " [[field]] '" + entry.name + "' mask";
             mask = compileOne(positionedSource(maskName, entry.mask, entry.maskLine, entry.maskCol),
-                              {}, "mask of field '" + entry.name + "'");
+                              {}, "mask of field '" + entry.name + "'", std::string());
             if (!mask) ok = false;
         }
         if (!field || !ok) {

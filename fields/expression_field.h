@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fields/field.h"
+#include "fields/geometry_paths.h"
 #include "fields/keyframes.h"
 #include "fields/scene.h"
 #include "runtime/program.h"
@@ -53,6 +54,10 @@ struct ExpressionFieldOptions {
     // The built-ins; null: sceneFunctions(*scene) with a scene, else fieldFunctions().
     std::shared_ptr<const runtime::FunctionTable> functions;
     std::string name; // for describe() (default: the source's name)
+    // Where file names in the expression (sdf("body.obj", ...), vdb(...)) resolve and which
+    // folders they may reach: when set, the geometry built-ins of `functions` are rebound to it
+    // (withFileAccess); unset, they resolve against the current folder.
+    std::optional<FileAccess> files;
 };
 
 class ExpressionField : public Field {
@@ -85,12 +90,20 @@ private:
     std::string mName;
 };
 
-// The standard built-ins plus the field layer's (gust, fftturb, ...).
+// The standard built-ins plus the field layer's (gust, fftturb, sdf, vdb, ...). File names in
+// expressions resolve against the current folder.
 std::shared_ptr<const runtime::FunctionTable> fieldFunctions();
+// The same with the geometry built-ins resolving file names under `access` (a new table).
+std::shared_ptr<const runtime::FunctionTable> fieldFunctions(const FileAccess& access);
+// A copy of `table` whose geometry built-ins resolve file names under `access`.
+std::shared_ptr<const runtime::FunctionTable>
+withFileAccess(const std::shared_ptr<const runtime::FunctionTable>& table, const FileAccess& access);
 
 // Registration of the field layer's built-ins (each defined in its own file).
 void addGustBuiltins(runtime::FunctionTable& t);       // rigs.cpp: gust(P)
 void addTurbulenceBuiltins(runtime::FunctionTable& t); // fftturb.cpp: fftturb, fftturb4
+// geometry_builtins.cpp: sdf, sdfgrad, shadow, vdb, meshvel (docs/geometry.md)
+void addGeometryBuiltins(runtime::FunctionTable& t, const FileAccess& access);
 
 // The expression of a [[field]] entry (its file, preset or inline source) as a SourceFile.
 // Inline text held verbatim in the scene is placed at its line and column in a file named after
@@ -100,7 +113,9 @@ bool fieldSource(const Scene& scene, const FieldEntry& entry, lang::SourceFile& 
 
 // The summed, compiled wind of a scene: every [[field]] with its params and scale. Diagnostics
 // of expression files are rendered (file:line:col + caret) into `report`. Null on errors.
+// File names in a field's expression resolve against its file's folder (the scene's for inline
+// source) and must stay inside the scene's folder or one of `allowPaths` (--allow-path).
 FieldPtr buildSceneField(const Scene& scene, runtime::Precision precision, std::string& report,
-                         bool color = false);
+                         bool color = false, const std::vector<std::string>& allowPaths = {});
 
 } // namespace gale::fields

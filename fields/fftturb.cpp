@@ -748,10 +748,23 @@ void sampleLanes(const runtime::KernelFrame<T>& f, const TurbCall& call) {
     }
 }
 
+// sigma = 0 (a preset with its turbulence turned off): zero velocity, and no grid is made or
+// sampled — a scene pays nothing for turbulence it does not use.
+template <class T>
+bool zeroWhenSilent(const runtime::KernelFrame<T>& f, int sigmaArg) {
+    if (f.args[sigmaArg].at(0, 0) != T(0)) return false;
+    for (int c = 0; c < 3; ++c) {
+        T* __restrict o = f.outComp(c);
+        for (int i = 0; i < f.n; ++i) o[i] = T(0);
+    }
+    return true;
+}
+
 // fftturb(P, L, sigma, seed, tile, res, interp) + implicit $turbMinScale.
 struct FftTurbK {
     template <class T>
     static void run(const runtime::KernelFrame<T>& f) {
+        if (zeroWhenSilent(f, 2)) return;
         auto u = [&](int k) { return static_cast<double>(f.args[k].at(0, 0)); };
         TurbCall call;
         if (!decode(u(1), u(2), u(3), u(4), u(5), u(6), u(7), call)) return fillNaN(f);
@@ -763,6 +776,7 @@ struct FftTurbK {
 struct FftTurb4K {
     template <class T>
     static void run(const runtime::KernelFrame<T>& f) {
+        if (zeroWhenSilent(f, 3)) return;
         auto u = [&](int k) { return static_cast<double>(f.args[k].at(0, 0)); };
         TurbCall call;
         const double t = static_cast<double>(static_cast<float>(u(1))), tau = u(8);

@@ -1,13 +1,18 @@
-// OpenVDB reading and writing of velocity grids — the only file that includes OpenVDB headers
-// (they are slow to compile); everything else goes through fields/vdb_io.h.
+// OpenVDB reading and writing of velocity grids, and the VelocityVolume behind vdb(). One of
+// the two files that include OpenVDB headers (they are slow to compile; vdb_geometry.cpp is the
+// other); everything else goes through fields/vdb_io.h and fields/geometry.h.
 #include "fields/vdb_io.h"
+
+#include "fields/geometry.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
+#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
@@ -220,5 +225,148 @@ IoError readVdbVelocity(const std::string& path, const std::string& gridName, Vd
     out = std::move(r);
     return {};
 }
+
+// ---- VelocityVolume (vdb() sampling) ----
+
+namespace {
+
+bool isVectorGrid(const openvdb::GridBase& g) {
+    return g.isType<openvdb::Vec3SGrid>() || g.isType<openvdb::Vec3DGrid>();
+}
+
+// "density (float), vel (vec3s)" for error messages.
+std::string gridList(const openvdb::GridPtrVec& grids) {
+    std::string out;
+    for (const openvdb::GridBase::Ptr& g : grids)
+        out += (out.empty() ? "" : ", ") + (g->getName().empty() ? std::string("<unnamed>")
+                                                                   : g->getName()) +
+               " (" + g->valueType() + ")";
+    return out.empty() ? std::string("none") : out;
+}
+
+// Picks the grid from descriptors or loaded grids; an error when absent or of the wrong type.
+IoError pickVectorGrid(const std::string& path, const std::string& gridName,
+                       const openvdb::GridPtrVec& grids, openvdb::GridBase::Ptr& out) {
+    for (const openvdb::GridBase::Ptr& g : grids) {
+        if (!gridName.empty() && g->getName() != gridName) continue;
+        if (!isVectorGrid(*g)) {
+            if (gridName.empty()) continue;
+            return makeError(IoError::Data, path,
+                             "grid '" + gridName + "' holds " + g->valueType() +
+                                 " values, not vectors (vec3s or vec3d)");
+        }
+        if (!g->transform().isLinear())
+            return makeError(IoError::Data, path,
+                             "grid '" + g->getName() + "' has a non-linear (frustum) transform");
+        out = g;
+        return {};
+    }
+    return makeError(IoError::Data, path,
+                     (gridName.empty() ? std::string("the file has no vector grid")
+                                       : "the file has no grid named '" + gridName + "'") +
+                         " (its grids: " + gridList(grids) + ")");
+}
+
+IoError readFailure(const std::string& path, const std::exception& e) {
+    std::string what = e.what();
+    if (what.empty()) what = "unknown error";
+    return makeError(IoError::Io, path,
+                     "cannot read the VDB file (missing, truncated or corrupt): " + what);
+}
+
+} // namespace
+
+struct VelocityVolume::Impl {
+    openvdb::Vec3SGrid::Ptr grid;
+    std::string name;
+    size_t memoryBytes = 0;
+};
+
+VelocityVolume::VelocityVolume(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+VelocityVolume::~VelocityVolume() = default;
+
+IoError checkVdbGrid(const std::string& path, const std::string& gridName) {
+    initOpenVdb();
+    try {
+        openvdb::io::File file(path);
+        file.open(false);
+        openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+        file.close();
+        openvdb::GridBase::Ptr grid;
+        return pickVectorGrid(path, gridName, *grids, grid);
+    } catch (const std::exception& e) {
+        return readFailure(path, e);
+    }
+}
+
+IoError VelocityVolume::load(const std::string& path, const std::string& gridName,
+                             std::shared_ptr<const VelocityVolume>& out) {
+    initOpenVdb();
+    openvdb::GridBase::Ptr grid;
+    try {
+        openvdb::io::File file(path);
+        file.open(false); // read everything now: a truncated file fails here, not mid-sample
+        openvdb::GridPtrVecPtr descriptors = file.readAllGridMetadata();
+        if (IoError e = pickVectorGrid(path, gridName, *descriptors, grid)) {
+            file.close();
+            return e;
+        }
+        grid = file.readGrid(grid->getName());
+        file.close();
+    } catch (const std::exception& e) {
+        return readFailure(path, e);
+    }
+    auto impl = std::make_unique<Impl>();
+    impl->name = grid->getName();
+    if (auto s = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid)) {
+        impl->grid = s;
+    } else if (auto d = openvdb::gridPtrCast<openvdb::Vec3DGrid>(grid)) {
+        impl->grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(d->background()));
+        impl->grid->setTree(std::make_shared<openvdb::Vec3STree>(d->tree()));
+        impl->grid->setTransform(d->transform().copy());
+    } else {
+        return makeError(IoError::Data, path, "grid '" + impl->name + "' is not a vector grid");
+    }
+    impl->memoryBytes = static_cast<size_t>(impl->grid->memUsage());
+    out = std::shared_ptr<const VelocityVolume>(new VelocityVolume(std::move(impl)));
+    return {};
+}
+
+void VelocityVolume::sample(const double* xyz, size_t n, VolumeInterp interp, double* vel) const {
+    const openvdb::Vec3SGrid& grid = *mImpl->grid;
+    const openvdb::math::Transform& xf = grid.transform();
+    auto acc = grid.getConstAccessor(); // one accessor per call: per thread, per block
+    const openvdb::Vec3d voxel = xf.voxelSize();
+    const double minVoxel = std::min(voxel[0], std::min(voxel[1], voxel[2]));
+    for (size_t i = 0; i < n; ++i) {
+        const openvdb::Vec3d p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+        openvdb::Vec3d index = xf.worldToIndex(p);
+        // A position within float rounding of a voxel centre reads that voxel exactly, so a
+        // grid written by `gale sample` reads back bit for bit at its cell centres even from
+        // float positions (a float keeps 24 bits: 6e-8 relative).
+        const double tol = 1.2e-7 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2])) / minVoxel +
+                           1e-9 * (1.0 + std::abs(index[0]) + std::abs(index[1]) + std::abs(index[2]));
+        for (int a = 0; a < 3; ++a) {
+            const double r = std::round(index[a]);
+            if (std::abs(index[a] - r) <= tol) index[a] = r;
+        }
+        openvdb::Vec3s v(0.0f);
+        switch (interp) {
+        case VolumeInterp::Nearest:
+            openvdb::tools::PointSampler::sample(acc, index, v);
+            break;
+        case VolumeInterp::Trilinear:
+            openvdb::tools::BoxSampler::sample(acc, index, v);
+            break;
+        case VolumeInterp::Quadratic:
+            openvdb::tools::QuadraticSampler::sample(acc, index, v);
+            break;
+        }
+        for (int c = 0; c < 3; ++c) vel[3 * i + static_cast<size_t>(c)] = v[c];
+    }
+}
+
+const std::string& VelocityVolume::gridName() const { return mImpl->name; }
+size_t VelocityVolume::memoryBytes() const { return mImpl->memoryBytes; }
 
 } // namespace gale::fields

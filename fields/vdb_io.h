@@ -1,6 +1,7 @@
 // OpenVDB files for velocity grids: write a dense, cell-centred Vec3s grid (named `vel`,
 // contravariant-relative, the Houdini/Blender convention) and read one back as a dense box.
-// vdb_io.cpp is the only translation unit that includes OpenVDB headers (they are slow).
+// vdb_io.cpp and vdb_geometry.cpp are the only translation units that include OpenVDB headers
+// (they are slow to compile); sampling a .vdb as a field is VelocityVolume in fields/geometry.h.
 #pragma once
 
 #include "fields/grid_sample.h"

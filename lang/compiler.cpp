@@ -589,6 +589,7 @@ Value Compiler::callBuiltin(const Expr* e, const FunctionInfo& fn, int32_t index
     site.span = e->span;
     site.nameSpan = e->nameSpan;
     site.sink = &mSink;
+    site.data = fn.hookData;
     std::vector<Span> spans;
     for (size_t i = 0; i < args.size(); ++i) spans.push_back(i < e->args.size() ? e->args[i]->span : e->span);
     // Check kinds and widths; find the broadcast width n of the FP[n] group.

@@ -27,6 +27,8 @@ struct CallSite {
     // A hook may override the result type the signature gives (kind and width; the compiler
     // fills the lifetime).
     Type resultType = Type::error();
+    // The function's FunctionInfo::hookData (e.g. the folder its file names resolve against).
+    const void* data = nullptr;
 };
 
 // One parameter of a parsed signature.
@@ -61,6 +63,8 @@ struct FunctionInfo {
     // Optional extra validation after the signature matched; reports to site.sink and
     // returns false on error; may set site.resultType.
     bool (*validate)(CallSite& site) = nullptr;
+    // Handed to `validate` as CallSite::data; owned by the host (runtime::Builtin::data).
+    const void* hookData = nullptr;
     // Host variables the compiler appends as extra arguments after the declared ones (e.g.
     // gust(P) also reads $t). A variable the host does not define is passed as the constant
     // `fallback`.

@@ -127,16 +127,17 @@ double Body::maxEdgeStretch() const {
 
 void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity) {
     const size_t n = vertexCount();
-    mA.setZero();
+    const bool matrix = !mOptions.explicitEuler; // the explicit baseline needs forces only
+    if (matrix) mA.setZero();
     mF.setZero(3 * n);
     mKv.setZero(3 * n);
     for (size_t i = 0; i < n; ++i) {
-        mA.addDiagonal(mA.diagonalSlot(static_cast<int>(i)), mMass[i]);
+        if (matrix) mA.addDiagonal(mA.diagonalSlot(static_cast<int>(i)), mMass[i]);
         if (!mHeld[i]) mF.segment<3>(3 * i) += mMass[i] * gravity;
     }
     out.f = &mF;
-    out.kv = &mKv;
-    out.A = &mA;
+    out.kv = matrix ? &mKv : nullptr;
+    out.A = matrix ? &mA : nullptr;
     addForces(in, out);
 }
 
@@ -279,19 +280,36 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     contactConstraints(env, t, h);
 
     // 4. Solve, warm-started from the previous substep's Δv scaled to this step.
+    SolveStatus ls;
+    if (mOptions.explicitEuler) {
+        // The explicit baseline: Δv = h M⁻¹ f, constrained vertices as prescribed.
+        mDv.resize(3 * n);
+        for (size_t i = 0; i < n; ++i) {
+            Vec3 dv = (h / mMass[i]) * vec3At(mF.data(), i);
+            if (mConstraints.kind[i] == 1) {
+                dv = vec3At(mConstraints.z.data(), i);
+            } else if (mConstraints.kind[i] == 2) {
+                const Vec3 nn = vec3At(mConstraints.normal.data(), i);
+                dv += nn * (vec3At(mConstraints.z.data(), i).dot(nn) - dv.dot(nn));
+            }
+            mDv.segment<3>(3 * i) = dv;
+        }
+        ls.converged = true;
+    } else {
     if (mOptions.warmStart && mDvGuess.size() == static_cast<long>(3 * n) && mHGuess > 0.0 &&
         mDvGuess.allFinite())
         mDv = mDvGuess * (h / mHGuess);
     else
         mDv.setZero(3 * n);
-    SolveStatus ls = mSolver.solve(mA, mConstraints, mB, mDv, mOptions.linearSolver,
-                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
+    ls = mSolver.solve(mA, mConstraints, mB, mDv, mOptions.linearSolver, mOptions.cgTolerance,
+                       mOptions.cgMaxIterations);
+    }
     st.iterations = ls.iterations;
     st.residual = ls.residual;
     st.converged = ls.converged && !ls.failed;
 
     // 5. Optional Newton iterations on the backward-Euler residual.
-    for (int k = 0; k < mOptions.newtonIterations && st.converged; ++k) {
+    for (int k = 0; k < mOptions.newtonIterations && st.converged && !mOptions.explicitEuler; ++k) {
         mV = v0 + mDv;
         mX = x0 + h * mV;
         in.x = mX.data();

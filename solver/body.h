@@ -42,6 +42,9 @@ struct StepOptions {
     int cgMaxIterations = 2000;
     int newtonIterations = 0;   // extra Newton iterations on the backward-Euler residual
     bool warmStart = true;      // start CG from the previous substep's Δv
+    // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
+    // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
+    bool explicitEuler = false;
 };
 
 // What a substep sees of the world.

@@ -52,7 +52,6 @@ private:
     std::vector<std::array<int, 16>> mHingeSlots;
     std::vector<double> mTriLift, mTriDrag; // mean painted map value per triangle (or empty)
     int mDegenerate = 0;
-    bool mSlotsReady = false;
 };
 
 } // namespace gale::solver

@@ -1,5 +1,6 @@
 // Signed distances of the analytic colliders and their surface velocities.
 #include "solver/collider.h"
+#include "solver/mesh_collider.h"
 
 #include <algorithm>
 #include <cmath>
@@ -32,6 +33,7 @@ ColliderPose colliderPose(const Collider& c, double t) {
     const double nn = p.normal.norm();
     p.normal = nn > 0.0 ? Vec3(p.normal / nn) : Vec3::UnitY();
     p.radius = c.radius;
+    p.mesh = c.mesh.get();
     return p;
 }
 
@@ -66,6 +68,10 @@ ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x) {
         cp.velocity = (1.0 - s) * pose.velA + s * pose.velB;
         break;
     }
+    case ColliderShape::Mesh:
+        if (pose.mesh) pose.mesh->query(x, cp.distance, cp.normal);
+        else cp.distance = 1e30; // not loaded: never touches
+        break;
     }
     return cp;
 }

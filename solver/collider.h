@@ -5,11 +5,14 @@
 #include "fields/keyframes.h"
 #include "solver/types.h"
 
+#include <memory>
 #include <string>
 
 namespace gale::solver {
 
-enum class ColliderShape { Plane, Sphere, Capsule };
+class MeshCollider; // solver/mesh_collider.h
+
+enum class ColliderShape { Plane, Sphere, Capsule, Mesh };
 
 struct Collider {
     std::string name;
@@ -22,6 +25,7 @@ struct Collider {
     double radius = 0.5;    // m (sphere, capsule)
     double thickness = 0.005; // m: vertices are kept this far outside the surface
     double friction = 0.3;  // Coulomb coefficient μ (dimensionless)
+    std::shared_ptr<const MeshCollider> mesh; // Mesh: the body's SDF (static)
 };
 
 // A contact query: signed distance to the surface (m, negative inside), the outward unit
@@ -38,6 +42,7 @@ struct ColliderPose {
     Vec3 a = Vec3::Zero(), b = Vec3::Zero(), normal = Vec3::UnitY();
     Vec3 velA = Vec3::Zero(), velB = Vec3::Zero(); // m/s of a and b (finite difference of keys)
     double radius = 0.0;
+    const MeshCollider* mesh = nullptr;
 };
 ColliderPose colliderPose(const Collider& c, double t);
 

@@ -66,7 +66,9 @@ int BlockMatrix::slot(int i, int j) const {
     return (it != e && *it == j) ? static_cast<int>(it - mBlockCols.begin()) : -1;
 }
 
-void BlockMatrix::setZero() { std::fill(mA.valuePtr(), mA.valuePtr() + mA.nonZeros(), 0.0); }
+void BlockMatrix::setZero() {
+    std::fill(mA.valuePtr(), mA.valuePtr() + mA.nonZeros(), 0.0);
+}
 
 Mat3 BlockMatrix::block(int slot) const {
     const double* p = mA.valuePtr() + mSlotBase[slot];
@@ -84,17 +86,43 @@ void BlockMatrix::setBlock(int slot, const Mat3& b) {
         for (int c = 0; c < 3; ++c) p[a * s + c] = b(a, c);
 }
 
-void BlockMatrix::multiply(const double* x, double* y) const {
-    const int* outer = mA.outerIndexPtr();
-    const int* inner = mA.innerIndexPtr();
-    const double* val = mA.valuePtr();
-    parallelChunks(static_cast<size_t>(3 * mN), 1536, [&](size_t r0, size_t r1) {
-        for (size_t r = r0; r < r1; ++r) {
-            double s = 0.0;
-            for (int p = outer[r]; p < outer[r + 1]; ++p) s += val[p] * x[inner[p]];
-            y[r] = s;
+namespace {
+template <class V>
+void blockMultiply(const int* outer, const V* val, const int* cols, const int* start, int n, const double* x,
+                   double* y) {
+    // Block row i: its three scalar rows are contiguous runs of 3·nb values; block k of the
+    // row holds columns 3j..3j+2, so each x block is loaded once for 9 products.
+    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const int nb = start[i + 1] - start[i];
+            const V* v0 = val + outer[3 * i];
+            const V* v1 = v0 + 3 * nb;
+            const V* v2 = v1 + 3 * nb;
+            const int* c = cols + start[i];
+            double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+            for (int k = 0; k < nb; ++k) {
+                const double* xj = x + 3 * c[k];
+                const double a = xj[0], b = xj[1], d = xj[2];
+                y0 += v0[3 * k] * a;
+                y0 += v0[3 * k + 1] * b;
+                y0 += v0[3 * k + 2] * d;
+                y1 += v1[3 * k] * a;
+                y1 += v1[3 * k + 1] * b;
+                y1 += v1[3 * k + 2] * d;
+                y2 += v2[3 * k] * a;
+                y2 += v2[3 * k + 1] * b;
+                y2 += v2[3 * k + 2] * d;
+            }
+            y[3 * i] = y0;
+            y[3 * i + 1] = y1;
+            y[3 * i + 2] = y2;
         }
     });
+}
+} // namespace
+
+void BlockMatrix::multiply(const double* x, double* y) const {
+    blockMultiply(mA.outerIndexPtr(), mA.valuePtr(), mBlockCols.data(), mBlockRowStart.data(), mN, x, y);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -136,23 +164,40 @@ void Constraints::apply(double* x) const {
 
 void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x,
                                    VecX& out) {
-    // Â x = S A S x + (I − S) x
-    const bool constrained = !c.kind.empty() && c.any();
-    if (!constrained) {
+    // Â x = S A S x + (I − S) x; S = I except at the constrained vertices (mConstrained).
+    if (mConstrained.empty()) {
         A.multiply(x.data(), out.data());
         return;
     }
     mTmp2 = x;
-    c.apply(mTmp2.data());
+    for (int i : mConstrained) {
+        Eigen::Map<Vec3> t(mTmp2.data() + 3 * i);
+        if (c.kind[i] == 1) t.setZero();
+        else {
+            const Vec3 n = vec3At(c.normal.data(), i);
+            t -= n.dot(t) * n;
+        }
+    }
     A.multiply(mTmp2.data(), out.data());
-    c.apply(out.data());
-    out += x - mTmp2;
+    for (int i : mConstrained) {
+        Eigen::Map<Vec3> o(out.data() + 3 * i);
+        const Eigen::Map<const Vec3> xi(x.data() + 3 * i);
+        if (c.kind[i] == 1) o = xi;
+        else {
+            const Vec3 n = vec3At(c.normal.data(), i);
+            o -= n.dot(o) * n;
+            o += n.dot(xi) * n;
+        }
+    }
 }
 
 SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
                                   LinearSolverKind kind, double tolerance, int maxIterations) {
     const int n3 = 3 * A.size();
     if (dv.size() != n3) dv = VecX::Zero(n3);
+    mConstrained.clear();
+    for (size_t i = 0; i < c.kind.size(); ++i)
+        if (c.kind[i]) mConstrained.push_back(static_cast<int>(i));
     // rhs = S (b − A z); initial y = S dv.
     VecX z = VecX::Zero(n3);
     if (!c.z.empty()) z = Eigen::Map<const VecX>(c.z.data(), n3);
@@ -228,6 +273,9 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
     precondition(mR, mZ);
     mP = mZ;
     double rz = deterministicDot(mR.data(), mZ.data(), n3);
+    // Fused vector updates, each reduction summed in fixed chunks (thread-count independent).
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    mPartial.assign(2 * chunks, 0.0);
     int it = 0;
     while (it < maxIterations) {
         applyFiltered(A, c, mP, mQ);
@@ -237,16 +285,44 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
             break;
         }
         const double alpha = rz / pq;
-        y += alpha * mP;
-        mR -= alpha * mQ;
+        // y += α p; r −= α q; z = P⁻¹ r; partial sums of r·r and r·z.
+        parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+            for (size_t ch = c0; ch < c1; ++ch) {
+                const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
+                double rr = 0.0, rzp = 0.0;
+                for (size_t k = b; k < e; ++k) {
+                    y[k] += alpha * mP[k];
+                    mR[k] -= alpha * mQ[k];
+                }
+                for (size_t k = b; k < e; k += 3) {
+                    const Mat3& P = mPrecond[k / 3];
+                    const double r0 = mR[k], r1 = mR[k + 1], r2 = mR[k + 2];
+                    const double z0 = P(0, 0) * r0 + P(0, 1) * r1 + P(0, 2) * r2;
+                    const double z1 = P(1, 0) * r0 + P(1, 1) * r1 + P(1, 2) * r2;
+                    const double z2 = P(2, 0) * r0 + P(2, 1) * r1 + P(2, 2) * r2;
+                    mZ[k] = z0;
+                    mZ[k + 1] = z1;
+                    mZ[k + 2] = z2;
+                    rr += r0 * r0 + r1 * r1 + r2 * r2;
+                    rzp += r0 * z0 + r1 * z1 + r2 * z2;
+                }
+                mPartial[2 * ch] = rr;
+                mPartial[2 * ch + 1] = rzp;
+            }
+        });
+        double rr = 0.0, rzNew = 0.0;
+        for (size_t ch = 0; ch < chunks; ++ch) {
+            rr += mPartial[2 * ch];
+            rzNew += mPartial[2 * ch + 1];
+        }
         ++it;
-        rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
-        if (rNorm <= target) break;
-        precondition(mR, mZ);
-        const double rzNew = deterministicDot(mR.data(), mZ.data(), n3);
+        rNorm = std::sqrt(rr);
+        if (rNorm <= target || !std::isfinite(rNorm)) break;
         const double beta = rzNew / rz;
         rz = rzNew;
-        mP = mZ + beta * mP;
+        parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
+            for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
+        });
     }
     st.iterations = it;
     st.residual = rNorm / rhsNorm;

@@ -103,12 +103,12 @@ private:
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
     VecX mTmp, mTmp2, mR, mZ, mP, mQ;
+    std::vector<double> mPartial;
+    std::vector<int> mConstrained; // vertices with S ≠ I
     std::vector<Mat3> mPrecond;
     using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor>;
     ColMatrix mFilteredA;
     std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix>> mLdlt;
-    const void* mLdltPattern = nullptr; // the matrix whose pattern mLdlt analysed
-    long mLdltNonZeros = -1;
 };
 
 } // namespace gale::solver

@@ -2,6 +2,7 @@
 // includes it: it is slow to compile). --set overrides are applied to the TOML tree by dotted
 // path first; then every key is checked and converted, every problem reported at file:line:col.
 #include "solver/scene.h"
+#include "solver/mesh_collider.h"
 
 #include "lang/functions.h"
 
@@ -70,7 +71,7 @@ const std::vector<std::string> kHairKeys = {
     "drag_tangent", "root_pinned", "pins", "linear_solver", "cg_tolerance", "cg_max_iterations",
     "newton_iterations", "output"};
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
-                                                "a", "b", "thickness", "friction"};
+                                                "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
 
 class Loader {
@@ -699,19 +700,20 @@ void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
     std::string type;
     const toml::node* tn = t.get("type");
     if (!tn) {
-        error(t, what + " needs type = \"plane\" | \"sphere\" | \"capsule\"");
+        error(t, what + " needs type = \"plane\" | \"sphere\" | \"capsule\" | \"mesh\"");
         return;
     }
     if (!choice(*tn, "collider type", {"plane", "sphere", "capsule", "mesh"}, type)) return;
-    if (type == "mesh") {
-        error(*tn, what + ": mesh colliders (SDF via OpenVDB) are not available yet; use plane, sphere or capsule");
-        return;
-    }
-    c.shape = type == "plane" ? ColliderShape::Plane : type == "sphere" ? ColliderShape::Sphere : ColliderShape::Capsule;
+    c.shape = type == "plane"    ? ColliderShape::Plane
+              : type == "sphere" ? ColliderShape::Sphere
+              : type == "mesh"   ? ColliderShape::Mesh
+                                 : ColliderShape::Capsule;
     const std::vector<std::string> need = type == "plane"    ? std::vector<std::string>{"point", "normal"}
                                           : type == "sphere" ? std::vector<std::string>{"center", "radius"}
+                                          : type == "mesh"   ? std::vector<std::string>{"mesh"}
                                                              : std::vector<std::string>{"a", "b", "radius"};
     std::vector<std::string> allowed = {"name", "type", "thickness", "friction"};
+    if (type == "mesh") allowed.push_back("voxel");
     allowed.insert(allowed.end(), need.begin(), need.end());
     for (auto&& [key, node] : t) {
         const std::string k(key.str());
@@ -733,6 +735,19 @@ void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
     if (const toml::node* n = t.get("radius")) number(*n, what + ": radius (m)", c.radius, 0.0, true);
     if (const toml::node* n = t.get("thickness")) number(*n, what + ": thickness (m)", c.thickness, 0.0, false);
     if (const toml::node* n = t.get("friction")) number(*n, what + ": friction", c.friction, 0.0, false);
+    // A mesh: its SDF (solver/mesh_collider.h), the file relative to the scene.
+    const toml::node* mesh = t.get("mesh");
+    std::string file;
+    double voxel = 0.01;
+    if (type != "mesh" || !mesh || !string(*mesh, what + ": mesh", file)) return;
+    if (const toml::node* n = t.get("voxel"))
+        if (!number(*n, what + ": voxel (m)", voxel, 0.0, true)) return;
+    const std::filesystem::path p(file);
+    const std::string path = p.is_absolute() ? file
+                             : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
+    std::string problem;
+    c.mesh = MeshCollider::load(path, voxel, problem);
+    if (!c.mesh) error(*mesh, what + ": " + problem);
 }
 
 void Loader::loadSolver(const toml::table& t, SolverSection& s) {

@@ -26,7 +26,11 @@ double deterministicDot(const double* a, const double* b, std::size_t n) {
         for (std::size_t i = 0; i < n; ++i) s += a[i] * b[i];
         return s;
     }
-    std::vector<double> partial(chunks, 0.0);
+    // Reused between calls; workers write through this reference (a thread_local named inside
+    // the lambda would be the worker's own).
+    thread_local std::vector<double> buffer;
+    std::vector<double>& partial = buffer;
+    partial.assign(chunks, 0.0);
     parallelChunks(chunks, 1, [&](std::size_t c0, std::size_t c1) {
         for (std::size_t c = c0; c < c1; ++c) {
             const std::size_t e = std::min(n, (c + 1) * kReduceChunk);

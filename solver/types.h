@@ -31,7 +31,7 @@ void parallelChunks(std::size_t n, std::size_t grain,
 
 // Dot product summed in fixed chunks of kReduceChunk entries, the partial sums added in chunk
 // order: the same bits on 1 or 64 threads.
-constexpr std::size_t kReduceChunk = 4096;
+constexpr std::size_t kReduceChunk = 3072; // a multiple of 3: chunks hold whole vertices
 double deterministicDot(const double* a, const double* b, std::size_t n);
 
 } // namespace gale::solver

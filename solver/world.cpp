@@ -82,8 +82,7 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
             }
             stats.windNonFinite += st.windNonFinite;
         }
-        bool accept = st.trouble == Trouble::None;
-        if (!accept) {
+        if (st.trouble != Trouble::None) {
             if (level < maxLevel) {
                 body.restore(snap);
                 ++level;
@@ -106,7 +105,6 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
             std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s) at the smallest substep %.6g s; accepted",
                           t, troubleName(st.trouble), st.reason.c_str(), h);
             stats.events.push_back(buf);
-            accept = true;
         }
         tick += ticksPerBase >> level;
         stats.contacts = st.contacts;

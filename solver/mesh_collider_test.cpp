@@ -1,0 +1,152 @@
+// Mesh colliders: the SDF of a box mesh against the analytic box distance and face normals,
+// the same through queryCollider, cloth draped over a mesh sphere staying outside it (within a
+// voxel), and the scene loader's [[collider]] type = "mesh" with its errors.
+#include "fields/geometry.h"
+#include "solver/cloth.h"
+#include "solver/collider.h"
+#include "solver/mesh_collider.h"
+#include "solver/scene.h"
+#include "solver/world.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+using namespace gale::solver;
+using gale::fields::Param;
+
+namespace {
+
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        char tmpl[] = "/tmp/gale_mesh_collider_XXXXXX";
+        path = mkdtemp(tmpl);
+    }
+    ~TempDir() { std::filesystem::remove_all(path); }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+// Distance to the box [-h, h] (outside: Euclidean; inside: minus the distance to the nearest face).
+double boxDistance(const Vec3& p, const Vec3& h) {
+    const Vec3 q = p.cwiseAbs() - h;
+    return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+}
+
+} // namespace
+
+TEST_CASE("mesh collider: distance and normal of a box mesh", "[collider][mesh]") {
+    TempDir dir;
+    const Vec3 h(0.3, 0.2, 0.25);
+    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(dir.file("box.obj"),
+                                                     gale::fields::boxMesh({-0.3, -0.2, -0.25},
+                                                                           {0.3, 0.2, 0.25})));
+    std::string error;
+    const double voxel = 0.01;
+    auto mesh = MeshCollider::load(dir.file("box.obj"), voxel, error);
+    INFO(error);
+    REQUIRE(mesh);
+    for (const Vec3& p : {Vec3(0.35, 0, 0), Vec3(0, 0.23, 0.1), Vec3(-0.1, 0.05, -0.31),
+                          Vec3(0.25, 0.0, 0.0), Vec3(0.1, -0.15, 0.05)}) {
+        double d = 0.0;
+        Vec3 n;
+        mesh->query(p, d, n);
+        INFO("p " << p.transpose() << " d " << d);
+        CHECK(std::abs(d - boxDistance(p, h)) < voxel);
+        CHECK(n.norm() == Approx(1.0));
+    }
+    double d = 0.0;
+    Vec3 n;
+    mesh->query(Vec3(0.4, 0.02, -0.03), d, n); // in front of the +x face
+    CHECK(n.x() > 0.99);
+    mesh->query(Vec3(0.01, -0.27, 0.0), d, n); // below the -y face
+    CHECK(n.y() < -0.99);
+
+    // The same through the collider interface.
+    Collider c;
+    c.shape = ColliderShape::Mesh;
+    c.mesh = mesh;
+    const ContactPoint cp = queryCollider(colliderPose(c, 0.0), Vec3(0.4, 0.02, -0.03));
+    CHECK(cp.distance == Approx(0.1).margin(voxel));
+    CHECK(cp.normal.x() > 0.99);
+    CHECK(cp.velocity.norm() == 0.0);
+
+    CHECK_FALSE(MeshCollider::load(dir.file("missing.obj"), voxel, error));
+    CHECK(error.find("missing.obj") != std::string::npos);
+}
+
+TEST_CASE("mesh collider: cloth draped over a mesh sphere stays outside it", "[collider][mesh]") {
+    TempDir dir;
+    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
+        dir.file("ball.obj"), gale::fields::uvSphereMesh({0, 0, 0}, 0.4, 24, 48)));
+    std::string error;
+    const double voxel = 0.02;
+    auto ball = MeshCollider::load(dir.file("ball.obj"), voxel, error);
+    REQUIRE(ball);
+    TriMesh sheet = makeGrid(1.2, 1.2, 16, 16, Vec3(-0.6, 0.6, -0.6), Vec3::UnitX(), Vec3::UnitZ());
+    ClothMaterial m;
+    m.density = 0.1;
+    m.lift.value = Param(0.0);
+    m.drag.value = Param(0.0);
+    World w(WorldSettings{});
+    w.addBody(std::make_unique<Cloth>("sheet", sheet, m));
+    Collider c;
+    c.shape = ColliderShape::Mesh;
+    c.mesh = ball;
+    c.thickness = 0.01;
+    w.addCollider(c);
+    int contacts = 0;
+    for (int f = 1; f <= 30; ++f) {
+        const FrameStats fs = w.advanceFrame(f);
+        REQUIRE_FALSE(fs.failed);
+        contacts = fs.bodies[0].contacts;
+        const VecX& x = w.bodies()[0]->positions();
+        double minDist = 1e9;
+        for (size_t i = 0; i < w.bodies()[0]->vertexCount(); ++i)
+            minDist = std::min(minDist, vec3At(x.data(), i).norm());
+        // The SDF is within a voxel of the (tessellated) sphere.
+        CHECK(minDist >= 0.4 + 0.01 - voxel);
+    }
+    CHECK(contacts > 10);
+    CHECK(w.bodies()[0]->positions()[1] < 0.0); // the corners fell below the top
+}
+
+TEST_CASE("mesh collider in a scene: [[collider]] type = \"mesh\"", "[collider][mesh][scene]") {
+    TempDir dir;
+    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
+        dir.file("body.obj"), gale::fields::boxMesh({-0.2, 0, -0.1}, {0.2, 1.6, 0.1})));
+    auto load = [&](const std::string& text, SimScene& scene, std::string& all) {
+        std::ofstream(dir.file("scene.toml")) << text;
+        std::vector<gale::fields::SceneError> errors;
+        const bool ok = loadSimScene(dir.file("scene.toml"), scene, errors);
+        all.clear();
+        for (const auto& e : errors) all += e.render() + "\n";
+        return ok;
+    };
+    SimScene scene;
+    std::string all;
+    REQUIRE(load("[[collider]]\nname = \"body\"\ntype = \"mesh\"\nmesh = \"body.obj\"\n"
+                 "voxel = 0.02\nthickness = 0.005\n",
+                 scene, all));
+    INFO(all);
+    REQUIRE(scene.colliders.size() == 1);
+    CHECK(scene.colliders[0].shape == ColliderShape::Mesh);
+    REQUIRE(scene.colliders[0].mesh);
+    CHECK(scene.colliders[0].mesh->sdf().voxel() == 0.02);
+    const ContactPoint cp = queryCollider(colliderPose(scene.colliders[0], 0.0), Vec3(0.5, 1, 0));
+    CHECK(cp.distance == Approx(0.3).margin(0.02));
+
+    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"nobody.obj\"\n", scene, all));
+    CHECK(all.find("scene.toml:3:8: error: [[collider]] 'collider0': cannot read") !=
+          std::string::npos);
+    CHECK(all.find("nobody.obj") != std::string::npos);
+    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\n", scene, all));
+    CHECK(all.find("a mesh collider needs 'mesh'") != std::string::npos);
+    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"body.obj\"\nradius = 1\n", scene, all));
+    CHECK(all.find("'radius' does not apply to a mesh collider") != std::string::npos);
+    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"body.obj\"\nvoxel = 0\n", scene, all));
+    CHECK(all.find("voxel") != std::string::npos);
+}
