@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <shared_mutex>
@@ -212,9 +213,10 @@ struct FrameMotion {
 IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxels,
                     std::shared_ptr<const FrameMotion>& out) {
     const size_t lo = j > 0 ? j - 1 : j, hi = j + 1 < ref.frames.size() ? j + 1 : j;
-    std::string key = "motion|" + ref.frames[j].key + "|" + ref.frames[lo].key + "|" +
-                      ref.frames[hi].key + "|" + std::to_string(voxel) + "|" +
-                      std::to_string(bandVoxels);
+    char voxelText[32];
+    std::snprintf(voxelText, sizeof voxelText, "%.17g", voxel);
+    const std::string key = "motion|" + ref.frames[j].key + "|" + ref.frames[lo].key + "|" +
+                            ref.frames[hi].key + "|" + voxelText + "|" + std::to_string(bandVoxels);
     return GeometryCache::global().get<FrameMotion>(
         key,
         [&](std::shared_ptr<const FrameMotion>& v, size_t& bytes) -> IoError {

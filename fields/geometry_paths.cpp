@@ -51,8 +51,10 @@ bool inside(const fs::path& p, const fs::path& dir) {
 // the root (absolute names must be inside an --allow-path folder).
 bool permitted(const FileAccess& access, const fs::path& target, bool allowedOnly) {
     if (!allowedOnly) {
-        const std::string root = access.rootDir.empty() ? access.baseDir : access.rootDir;
-        if (inside(target, canonicalOf(absoluteDir(root)))) return true;
+        // The folder names resolve in (the expression's) and the root (a scene's folder).
+        if (inside(target, canonicalOf(absoluteDir(access.baseDir)))) return true;
+        if (!access.rootDir.empty() && inside(target, canonicalOf(absoluteDir(access.rootDir))))
+            return true;
     }
     for (const std::string& a : access.allowed)
         if (!a.empty() && inside(target, canonicalOf(absoluteDir(a)))) return true;
@@ -60,8 +62,10 @@ bool permitted(const FileAccess& access, const fs::path& target, bool allowedOnl
 }
 
 std::string rootText(const FileAccess& access) {
-    const std::string root = access.rootDir.empty() ? access.baseDir : access.rootDir;
-    return canonicalOf(absoluteDir(root)).string();
+    const fs::path base = canonicalOf(absoluteDir(access.baseDir));
+    if (access.rootDir.empty()) return base.string();
+    const fs::path root = canonicalOf(absoluteDir(access.rootDir));
+    return inside(base, root) ? root.string() : root.string() + " and " + base.string();
 }
 
 // The cache key of an existing file; false with `error` when it cannot be stat'ed.

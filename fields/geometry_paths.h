@@ -11,7 +11,7 @@ namespace gale::fields {
 
 struct FileAccess {
     std::string baseDir;              // names resolve against this folder ("": the current one)
-    std::string rootDir;              // and must stay inside this one ("": baseDir)
+    std::string rootDir;              // and must stay inside it or this one (a scene's folder)
     std::vector<std::string> allowed; // --allow-path folders: anything inside them is allowed
 };
 

@@ -117,6 +117,15 @@ TEST_CASE("the root may be wider than the folder names resolve against", "[geome
     CHECK(ok(a, "../body.obj"));
     CHECK(errorOf(a, "../../outside/secret.obj").find("leads outside " + t.str("shot")) !=
           std::string::npos);
+    // An expression file outside the scene's folder (a wedge variant names the original by
+    // its absolute path): its own folder stays a root.
+    FileAccess moved = fileAccessFor(t.str("outside/field.se"));
+    moved.rootDir = t.str("shot/meshes");
+    CHECK(ok(moved, "secret.obj"));
+    CHECK(ok(moved, "../shot/meshes/cape.obj"));
+    CHECK(errorOf(moved, "../shot/body.obj")
+              .find("leads outside " + t.str("shot/meshes") + " and " + t.str("outside")) !=
+          std::string::npos);
 }
 
 TEST_CASE("`#` sequences: frames found with their padding, picked by frame", "[geometry][paths]") {
