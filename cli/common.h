@@ -106,8 +106,8 @@ std::string formatValue(double v, bool asFloat);
 // returns kExitIo on failure.
 int writeTextFileAtomic(const std::string& path, const std::string& text);
 
-// A JSON string literal.
-std::string jsonString(const std::string& s);
+// A JSON string literal (the point-set writer's escaping, so every JSON gale writes agrees).
+using fields::jsonString;
 
 // Word-wraps help text to `width` columns (CLI11 indents the continuation lines).
 std::string wrapHelp(const std::string& text, size_t width = 62);

@@ -324,43 +324,12 @@ IoError writeCsv(std::ostream& out, const PointSet& ps) {
     return {};
 }
 
-void appendJsonString(std::string& out, const std::string& s) {
-    out += '"';
-    for (unsigned char ch : s) {
-        switch (ch) {
-        case '"':
-            out += "\\\"";
-            break;
-        case '\\':
-            out += "\\\\";
-            break;
-        case '\n':
-            out += "\\n";
-            break;
-        case '\t':
-            out += "\\t";
-            break;
-        case '\r':
-            out += "\\r";
-            break;
-        default:
-            if (ch < 0x20) {
-                char esc[8];
-                std::snprintf(esc, sizeof esc, "\\u%04x", ch);
-                out += esc;
-            } else {
-                out += static_cast<char>(ch);
-            }
-        }
-    }
-    out += '"';
-}
 
 IoError writeJson(std::ostream& out, const PointSet& ps) {
     std::vector<std::string> keys;
     for (const std::string& name : ps.names) {
         std::string k;
-        appendJsonString(k, name);
+        k += jsonString(name);
         keys.push_back(k + ": ");
     }
     size_t n = ps.size();
@@ -528,6 +497,41 @@ std::vector<PointVariable> pointVariables(const PointSet& points) {
         vars.push_back({name, {static_cast<int>(c)}});
     }
     return vars;
+}
+
+// A JSON string literal, quotes included, with control characters escaped.
+std::string jsonString(const std::string& s) {
+    std::string out;
+    out += '"';
+    for (unsigned char ch : s) {
+        switch (ch) {
+        case '"':
+            out += "\\\"";
+            break;
+        case '\\':
+            out += "\\\\";
+            break;
+        case '\n':
+            out += "\\n";
+            break;
+        case '\t':
+            out += "\\t";
+            break;
+        case '\r':
+            out += "\\r";
+            break;
+        default:
+            if (ch < 0x20) {
+                char esc[8];
+                std::snprintf(esc, sizeof esc, "\\u%04x", ch);
+                out += esc;
+            } else {
+                out += static_cast<char>(ch);
+            }
+        }
+    }
+    out += '"';
+    return out;
 }
 
 } // namespace gale::fields

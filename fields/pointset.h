@@ -67,6 +67,9 @@ IoError writePointsFile(const std::string& path, const PointSet& points, PointFo
 // Shortest decimal that round-trips (std::to_chars): 7, 0.1, 1e-07, -0, nan, inf.
 std::string formatNumber(double v);
 
+// A JSON string literal: quotes, backslashes and control characters escaped.
+std::string jsonString(const std::string& s);
+
 // Host variables a point set provides: (x,y,z) -> P, (nx,ny,nz) -> N, every other column a
 // scalar of its own name (characters outside [A-Za-z0-9_.] become '_', a name that does not
 // start with a letter or '_' gets a leading '_'). When two columns map to the same name, the
