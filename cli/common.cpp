@@ -360,4 +360,20 @@ void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType) {
             ->capture_default_str();
 }
 
+bool parseFrames(const std::string& text, int& a, int& b) {
+    const size_t colon = text.find(':');
+    if (colon == std::string::npos) return false;
+    try {
+        size_t used = 0;
+        a = std::stoi(text.substr(0, colon), &used);
+        if (used != colon) return false;
+        const std::string rest = text.substr(colon + 1);
+        b = std::stoi(rest, &used);
+        if (used != rest.size()) return false;
+    } catch (...) {
+        return false;
+    }
+    return b >= a;
+}
+
 } // namespace gale::cli

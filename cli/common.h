@@ -106,6 +106,9 @@ std::string formatValue(double v, bool asFloat);
 // returns kExitIo on failure.
 int writeTextFileAtomic(const std::string& path, const std::string& text);
 
+// `--frames A:B` of sim and wedge: two whole numbers, A <= B (a single frame is refused).
+bool parseFrames(const std::string& text, int& a, int& b);
+
 // A JSON string literal (the point-set writer's escaping, so every JSON gale writes agrees).
 using fields::jsonString;
 

@@ -194,22 +194,6 @@ int writeFrame(const solver::SimScene& sc, const solver::World& w, const std::st
     return kExitOk;
 }
 
-bool parseFrames(const std::string& text, int& a, int& b) {
-    const size_t colon = text.find(':');
-    if (colon == std::string::npos) return false;
-    try {
-        size_t used = 0;
-        a = std::stoi(text.substr(0, colon), &used);
-        if (used != colon) return false;
-        const std::string rest = text.substr(colon + 1);
-        b = std::stoi(rest, &used);
-        if (used != rest.size()) return false;
-    } catch (...) {
-        return false;
-    }
-    return b >= a;
-}
-
 class Progress {
 public:
     explicit Progress(int total) : mTotal(total), mOn(isatty(2) != 0), mStart(std::chrono::steady_clock::now()) {}

@@ -39,22 +39,6 @@ bool readAll(const fs::path& path, std::string& out) {
     return true;
 }
 
-bool parseFrameRange(const std::string& text, int& a, int& b) {
-    const size_t colon = text.find(':');
-    if (colon == std::string::npos) return false;
-    try {
-        size_t used = 0;
-        a = std::stoi(text.substr(0, colon), &used);
-        if (used != colon) return false;
-        const std::string rest = text.substr(colon + 1);
-        b = std::stoi(rest, &used);
-        if (used != rest.size()) return false;
-    } catch (...) {
-        return false;
-    }
-    return b >= a;
-}
-
 std::string describe(const Variant& v) {
     std::string s = v.id + " (";
     for (size_t i = 0; i < v.values.size(); ++i) s += (i ? ", " : "") + v.values[i].first + "=" + v.values[i].second;
@@ -92,7 +76,7 @@ int runWedge(const WedgeOptions& o) {
     std::vector<std::string> common = o.sets;
     if (!o.frames.empty()) {
         int a = 0, b = 0;
-        if (!parseFrameRange(o.frames, a, b)) {
+        if (!parseFrames(o.frames, a, b)) {
             printError("--frames must be A:B with whole numbers A <= B, not '" + o.frames + "'");
             return kExitUsage;
         }
