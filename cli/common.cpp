@@ -336,18 +336,24 @@ void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths) {
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
-void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType) {
+void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType, bool scenes) {
     CLI::Option* file =
-        app.add_option("file", options.file, "Expression file (.se); '-' reads it from stdin")
-            ->type_name("FILE");
+        scenes ? app.add_option("file", options.file,
+                                "Expression file (.se; '-' reads stdin) or scene file (.toml)")
+                     ->type_name("FILE|SCENE")
+               : app.add_option("file", options.file, "Expression file (.se); '-' reads it from stdin")
+                     ->type_name("FILE");
     CLI::Option* expr =
         app.add_option("-e,--expr", options.expr, "Expression text instead of a file")
             ->type_name("EXPR");
     file->excludes(expr);
     expr->excludes(file);
     app.add_option("--set", options.sets,
-                   "Bind host variable $NAME as a uniform: a number (5), a vector (1,2,3) or a "
-                   "quoted string; repeatable")
+                   scenes ? "Expression: override parameter (or bind variable) $NAME with a number or "
+                            "x,y,z. Scene: override a key by its dotted path (windicator.speed=12). "
+                            "Repeatable"
+                          : "Bind host variable $NAME as a uniform: a number (5), a vector (1,2,3) or a "
+                            "quoted string; repeatable")
         ->type_name("NAME=VALUE")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);

@@ -116,6 +116,7 @@ using fields::jsonString;
 std::string wrapHelp(const std::string& text, size_t width = 62);
 
 // Adds `FILE` / `-e,--expr` / `--set` / `--type` / `--allow-path` to a subcommand.
-void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType = true);
+void addSourceOptions(CLI::App& app, SourceOptions& options, bool withType = true,
+                      bool scenes = false);
 
 } // namespace gale::cli

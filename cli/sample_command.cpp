@@ -216,23 +216,7 @@ Command addSampleCommand(CLI::App& app) {
         "sample", "Sample the wind of an expression or scene at the cell centres of a grid and "
                   "write it as a .vdb (one Vec3s grid named vel), .npy (float32, shape "
                   "(nx,ny,nz,3), x slowest) or .csv (x,y,z,vx,vy,vz), once or per frame.");
-    CLI::Option* file =
-        sub->add_option("file", o->source.file,
-                        "Expression file (.se; '-' reads stdin) or scene file (.toml)")
-            ->type_name("FILE|SCENE");
-    CLI::Option* expr =
-        sub->add_option("-e,--expr", o->source.expr, "Expression text instead of a file")
-            ->type_name("EXPR");
-    file->excludes(expr);
-    expr->excludes(file);
-    sub->add_option("--set", o->source.sets,
-                    "Expression: override parameter (or bind variable) $NAME with a number or "
-                    "x,y,z. Scene: override a key by its dotted path (windicator.speed=12). "
-                    "Repeatable")
-        ->type_name("NAME=VALUE")
-        ->expected(1)
-        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    addAllowPathOption(*sub, o->source.allowPaths);
+    addSourceOptions(*sub, o->source, /*withType=*/false, /*scenes=*/true);
     sub->add_option("--bounds", o->bounds,
                     "The box to sample, metres: x0,y0,z0,x1,y1,z1; the grid starts at its min "
                     "corner")

@@ -268,23 +268,7 @@ Command addVizCommand(CLI::App& app) {
         "viz", "Draw a slice of the wind as a PNG or SVG picture: colour = speed (viridis, with "
                "a legend in m/s), arrows or streamlines for the in-plane direction, and for "
                "scenes the windicator arrow, gust fronts and a gust timeline.");
-    CLI::Option* file =
-        sub->add_option("file", o->source.file,
-                        "Expression file (.se; '-' reads stdin) or scene file (.toml)")
-            ->type_name("FILE|SCENE");
-    CLI::Option* expr =
-        sub->add_option("-e,--expr", o->source.expr, "Expression text instead of a file")
-            ->type_name("EXPR");
-    file->excludes(expr);
-    expr->excludes(file);
-    sub->add_option("--set", o->source.sets,
-                    "Expression: override parameter (or bind variable) $NAME with a number or "
-                    "x,y,z. Scene: override a key by its dotted path (windicator.speed=12). "
-                    "Repeatable")
-        ->type_name("NAME=VALUE")
-        ->expected(1)
-        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    addAllowPathOption(*sub, o->source.allowPaths);
+    addSourceOptions(*sub, o->source, /*withType=*/false, /*scenes=*/true);
     sub->add_option("--plane", o->plane,
                     "The slice: z=C (drawn with x right, y up), y=C (x right, z up) or x=C (z "
                     "right, y up)")
