@@ -81,7 +81,7 @@ private:
 
     // ---- registers and emission ----
     Reg newReg(const Type& t);
-    Value constant(const std::vector<double>& values, Lifetime l = Lifetime::Constant);
+    Value constant(const std::vector<double>& values);
     Value constant(double v) { return constant(std::vector<double>{v}); }
     Value constantString(const std::string& s);
     Value emit(Instr in, Type result, bool pure = true);
@@ -165,7 +165,7 @@ Reg Compiler::newReg(const Type& t) {
     return mBc.addReg(info);
 }
 
-Value Compiler::constant(const std::vector<double>& values, Lifetime) {
+Value Compiler::constant(const std::vector<double>& values) {
     std::vector<uint64_t> key(values.size());
     for (size_t i = 0; i < values.size(); ++i) std::memcpy(&key[i], &values[i], sizeof(double));
     Type t = Type::fp(static_cast<int>(values.size()), Lifetime::Constant);

@@ -48,12 +48,10 @@ public:
         std::string messages;
         ctx.messages = &messages;
         lang::Instr in = instr;
-        in.dst = lang::kNoReg;
-        in.width = instr.width;
+        in.dst = lang::kNoReg; // the result goes to foldOut / foldString
         if (in.op == lang::Op::Call) {
             const Builtin& fn = mFunctions.at(in.imm);
             if (!fn.kernelD || fn.info.sideEffects || !fn.info.foldable) return false;
-            // Width of a call's result is only known to the compiler; it passes it in `width`.
         }
         execute(in, ctx);
         values.assign(out, out + std::max<int>(1, in.width));
