@@ -12,7 +12,7 @@ DEB_PACKAGES := g++ cmake ninja-build pkg-config make \
 	libtbb-dev catch2 libcli11-dev libtomlplusplus-dev libtinyobjloader-dev \
 	libcairo2-dev libpng-dev parallel
 
-.PHONY: all deps configure build demo test bench report clean format
+.PHONY: all deps configure build demo test test-asan test-tsan fuzz bench report clean format
 
 all: build
 
@@ -49,7 +49,7 @@ demo: build
 	@echo "           breeze wind on a point set: $(DEMO_OUT)/breeze.ply"
 
 test: build
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE heavy
 
 bench: build
 	$(BUILD)/bench/gale_bench_vm
@@ -63,6 +63,63 @@ report: build
 		if [ "$$(id -u)" != 0 ]; then echo "gale: report needs python3-matplotlib (run as root or install it)"; exit 1; fi; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends python3-matplotlib; }
 	$(PYTHON) bench/report.py --build $(BUILD) --out bench
+
+# --- Hardening (issue 8) --------------------------------------------------------------------
+# See docs/sanitizers.md. Reports go to files (log_path), not only stderr: a test that expects a
+# failing exit code would otherwise pass when UBSan halts with exit code 1. Any report file
+# left after the run fails the target, whatever ctest says.
+ASAN_BUILD ?= build-asan
+# ccache only when installed (CI machines start without it).
+SAN_LAUNCHER := $(if $(shell command -v ccache 2>/dev/null),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+SAN_CMAKE  := -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALE_BUILD_BENCH=OFF $(SAN_LAUNCHER)
+SAN_SUPP   := $(CURDIR)/tests/sanitizers
+# san_check DIR: prints every report under DIR and fails when there is one.
+san_check = if [ -n "$$(ls -A $(1) 2>/dev/null)" ]; then cat $(1)/*; \
+	echo "gale: sanitizer reports above (files in $(1))"; exit 1; fi
+# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer; any report fails.
+# float-cast-overflow is not part of gcc's `undefined`: casts of NaN/inf/huge values to int.
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD) $(SAN_CMAKE) -DGALE_SANITIZE=address,undefined,float-cast-overflow
+	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	@rm -rf $(ASAN_BUILD)/san-reports && mkdir -p $(ASAN_BUILD)/san-reports
+	cd $(ASAN_BUILD) && \
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:log_path=$(abspath $(ASAN_BUILD))/san-reports/asan \
+	LSAN_OPTIONS=suppressions=$(SAN_SUPP)/lsan.supp \
+	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$(abspath $(ASAN_BUILD))/san-reports/ubsan \
+		ctest --output-on-failure -j $(JOBS) -LE heavy; rc=$$?; \
+	$(call san_check,san-reports); exit $$rc
+
+# ThreadSanitizer over the multi-threaded evaluator and solver tests (only those two are built).
+TSAN_BUILD ?= build-tsan
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD) $(SAN_CMAKE) -DGALE_SANITIZE=thread
+	cmake --build $(TSAN_BUILD) -j $(JOBS) --target runtime_tests solver_tests
+	@rm -rf $(TSAN_BUILD)/san-reports && mkdir -p $(TSAN_BUILD)/san-reports
+	cd $(TSAN_BUILD) && \
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$(SAN_SUPP)/tsan.supp:log_path=$(abspath $(TSAN_BUILD))/san-reports/tsan \
+		ctest --output-on-failure -j $(JOBS) -LE heavy -R '^(runtime|solver)_tests:'; rc=$$?; \
+	$(call san_check,san-reports); exit $$rc
+
+# libFuzzer harnesses (clang); each runs FUZZ_SECONDS on its seed corpus.
+FUZZ_BUILD   ?= build-fuzz
+FUZZ_SECONDS ?= 300
+FUZZ_DEB_PACKAGES := clang libclang-rt-14-dev llvm
+FUZZ_HARNESSES    := fuzz_compile fuzz_eval fuzz_scene fuzz_readers
+FUZZ_LAUNCHER     := $(if $(shell command -v ccache 2>/dev/null),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fuzz: deps
+	@missing=""; for p in $(FUZZ_DEB_PACKAGES); do \
+		dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+		echo "gale: installing missing Debian packages for fuzzing:$$missing"; \
+		if [ "$$(id -u)" != 0 ]; then echo "gale: run as root (or install them yourself)"; exit 1; fi; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+	CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALE_FUZZ=ON \
+		-DGALE_SANITIZE=address,undefined -DGALE_BUILD_TESTS=OFF -DGALE_BUILD_BENCH=OFF $(FUZZ_LAUNCHER)
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(FUZZ_HARNESSES)
+	fuzz/seed.sh $(FUZZ_BUILD)/corpus
+	fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(FUZZ_HARNESSES)
 
 format:
 	clang-format -i $$(git ls-files '*.h' '*.cpp')
