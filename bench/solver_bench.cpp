@@ -1,7 +1,8 @@
 // gale_bench_solver: speed against error for the implicit cloth solver, next to an explicit
 // symplectic-Euler baseline measured in the same run; cost per vertex per step and CG
 // iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix.
-//   gale_bench_solver [--quick] [--out DIR]   (DIR gets CSV tables and SVG plots)
+//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability]
+//   (DIR gets CSV tables and SVG plots; --only runs one section)
 #include "solver/cloth.h"
 #include "solver/world.h"
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <memory>
@@ -53,6 +55,7 @@ struct Integrator {
     const char* name;
     bool explicitEuler;
     double tol;
+    bool multigrid = false; // PCG preconditioner: multigrid, else block Jacobi
 };
 
 struct FlagSpec {
@@ -96,16 +99,25 @@ std::unique_ptr<World> makeFlag(const FlagSpec& f, double fps, int substeps, boo
 struct RunResult {
     bool blewUp = false;
     double seconds = 0.0;
+    double cpuSeconds = 0.0; // process CPU time (the machine may be shared)
     long iterations = 0;
     long substeps = 0;
     VecX x;
 };
 
-// Runs `frames` frames; counts wall time of all of them.
+double cpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// Runs `frames` frames; counts wall and CPU time of all of them.
 RunResult runFrames(World& w, int frames) {
     RunResult r;
     for (int f = 1; f <= frames; ++f) {
+        const double c0 = cpuSeconds();
         const FrameStats fs = w.advanceFrame(f);
+        r.cpuSeconds += cpuSeconds() - c0;
         r.seconds += fs.wallSeconds;
         r.iterations += fs.bodies[0].iterations;
         r.substeps += fs.bodies[0].substeps;
@@ -264,8 +276,10 @@ void flagBench(bool quick, const std::string& out) {
         std::printf("reference: h = 1/%d s, CG tol 1e-9, %.2f s wall\n\n", 24 * 4 * 64, r0.seconds);
         std::printf("| integrator | CG tol | h (s) | RMS error (m) | wall (ms) | CG its/step |\n|---|---|---|---|---|---|\n");
         std::vector<Series> series;
-        std::vector<Integrator> ints = {{"implicit", false, 1e-1}, {"implicit", false, 1e-3},
-                                        {"implicit", false, 1e-6}, {"explicit", true, 0}};
+        std::vector<Integrator> ints = {{"implicit", false, 1e-1},      {"implicit", false, 1e-3},
+                                        {"implicit", false, 1e-6},      {"implicit MG", false, 1e-1, true},
+                                        {"implicit MG", false, 1e-3, true}, {"implicit MG", false, 1e-6, true},
+                                        {"explicit", true, 0}};
         if (model == AeroModel::Frozen) ints = {{"implicit", false, 1e-3}, {"explicit", true, 0}};
         for (const Integrator& in : ints) {
             Series s;
@@ -275,6 +289,7 @@ void flagBench(bool quick, const std::string& out) {
                 if (quick && sub > 16) continue;
                 if (!in.explicitEuler && sub > 16) continue;
                 auto w = makeFlag(f, 24.0, sub, in.explicitEuler, in.tol > 0 ? in.tol : 1e-3);
+                if (in.multigrid) w->bodies()[0]->options().preconditioner = Preconditioner::Multigrid;
                 const RunResult r = runFrames(*w, frames);
                 const double err = r.blewUp ? -1 : rms(r.x, r0.x);
                 std::printf("| %s | %s | 1/%d | %s | %.1f | %.1f |\n", in.name,
@@ -299,33 +314,58 @@ void flagBench(bool quick, const std::string& out) {
 
 // ---- 3. cost per vertex per step --------------------------------------------------------------
 
+struct SolverChoice {
+    const char* name;
+    LinearSolverKind kind;
+    Preconditioner pre;
+};
+const SolverChoice kSolvers[] = {{"pcg, block Jacobi", LinearSolverKind::Pcg, Preconditioner::BlockJacobi},
+                                 {"pcg, multigrid", LinearSolverKind::Pcg, Preconditioner::Multigrid},
+                                 {"direct", LinearSolverKind::Direct, Preconditioner::BlockJacobi}};
+
+void setSolver(World& w, const SolverChoice& s) {
+    Body& b = *w.bodies()[0];
+    b.options().linearSolver = s.kind;
+    b.options().preconditioner = s.pre;
+}
+
 void scalingBench(bool quick) {
     std::printf("\n## Cost per vertex per step, one thread: flag 1 m, sigma 0.1 kg/m^2, stretch 2000 N/m, gusty 12 m/s,"
-                " h = 1/240 s, CG tol 1e-3 (block-Jacobi PCG) and the sparse LDL^T\n\n");
-    std::printf("| cloth | solver | us/vertex/step | ms/step | CG its/step |\n|---|---|---|---|---|\n");
+                " h = 1/240 s, CG tol 1e-3, block-Jacobi and multigrid PCG and the sparse LDL^T in the same run"
+                " (CPU: process CPU time, robust on a shared machine)\n\n");
+    std::printf("| cloth | solver | us/vertex/step (CPU) | us/vertex/step (wall) | ms/step (CPU) | CG its/step |\n"
+                "|---|---|---|---|---|---|\n");
     for (int n : {32, 64, 128})
-        for (LinearSolverKind k : {LinearSolverKind::Pcg, LinearSolverKind::Direct}) {
+        for (const SolverChoice& s : kSolvers) {
             if (quick && n == 128) continue;
+            if (n == 128 && s.kind == LinearSolverKind::Direct) continue;
             FlagSpec f;
             f.n = n;
             f.wind = 12.0;
-            auto w = makeFlag(f, 240.0, 1, false, 1e-3, 0, k);
+            auto w = makeFlag(f, 240.0, 1, false, 1e-3, 0);
+            setSolver(*w, s);
             runFrames(*w, n == 128 ? 6 : 24); // warm-up: the flag starts moving
             const RunResult r = runFrames(*w, n == 128 ? 12 : 48);
             const double per = r.seconds / std::max<long>(r.substeps, 1);
-            std::printf("| %dx%d | %s | %.2f | %.2f | %.1f |\n", n, n, k == LinearSolverKind::Pcg ? "pcg" : "direct",
-                        per * 1e6 / (n * n), per * 1e3, double(r.iterations) / std::max<long>(r.substeps, 1));
+            const double cpu = r.cpuSeconds / std::max<long>(r.substeps, 1);
+            std::printf("| %dx%d | %s | %.2f | %.2f | %.2f | %.1f |\n", n, n, s.name, cpu * 1e6 / (n * n),
+                        per * 1e6 / (n * n), cpu * 1e3, double(r.iterations) / std::max<long>(r.substeps, 1));
         }
     // The real-time check: 32x32 at 24 fps with 4 substeps (h = 1/96 s).
-    FlagSpec f;
-    f.n = 32;
-    f.wind = 12.0;
-    auto w = makeFlag(f, 24.0, 4, false, 1e-3, 6);
-    runFrames(*w, 6);
-    const RunResult r = runFrames(*w, 48);
-    std::printf("\n32x32 at 24 fps, 4 substeps (robust stepping on): %.2f ms per frame = %.2fx real time "
-                "(%.1f CG its/substep)\n",
-                r.seconds / 48 * 1e3, (1.0 / 24) / (r.seconds / 48), double(r.iterations) / r.substeps);
+    std::printf("\n");
+    for (int k = 0; k < 2; ++k) {
+        FlagSpec f;
+        f.n = 32;
+        f.wind = 12.0;
+        auto w = makeFlag(f, 24.0, 4, false, 1e-3, 6);
+        setSolver(*w, kSolvers[k]);
+        runFrames(*w, 6);
+        const RunResult r = runFrames(*w, 48);
+        std::printf("32x32 at 24 fps, 4 substeps (robust stepping on), %s: %.2f ms CPU (%.2f ms wall) per frame = "
+                    "%.2fx real time by CPU (%.1f CG its/substep)\n",
+                    kSolvers[k].name, r.cpuSeconds / 48 * 1e3, r.seconds / 48 * 1e3, (1.0 / 24) / (r.cpuSeconds / 48),
+                    double(r.iterations) / r.substeps);
+    }
 }
 
 // ---- 4. edge-on stability (aero.md) -----------------------------------------------------------
@@ -379,19 +419,20 @@ void stabilityBench(bool quick) {
 
 int main(int argc, char** argv) {
     bool quick = false;
-    std::string out;
+    std::string out, only;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+        else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
         else {
-            std::fprintf(stderr, "usage: gale_bench_solver [--quick] [--out DIR]\n");
+            std::fprintf(stderr, "usage: gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability]\n");
             return 2;
         }
     }
     std::printf("# gale_bench_solver%s\n", quick ? " (--quick)" : "");
-    plateBench(quick, out);
-    flagBench(quick, out);
-    scalingBench(quick);
-    stabilityBench(quick);
+    if (only.empty() || only == "plate") plateBench(quick, out);
+    if (only.empty() || only == "flag") flagBench(quick, out);
+    if (only.empty() || only == "scaling") scalingBench(quick);
+    if (only.empty() || only == "stability") stabilityBench(quick);
     return 0;
 }

@@ -19,6 +19,9 @@ namespace gale::cli {
 
 namespace {
 
+// Positions (24 bytes a point) and results (up to 16 doubles) are held in memory.
+constexpr long long kMaxBenchPoints = 100'000'000;
+
 // 3N coordinates, uniform in [-50,50): mt19937_64 is specified bit for bit, and the mapping to
 // [0,1) is ours (std::uniform_real_distribution differs between standard libraries).
 std::vector<double> randomPoints(size_t n) {
@@ -63,8 +66,9 @@ int benchLoop(const runtime::Program& program, const runtime::EvalRequest& reque
 } // namespace
 
 int runBench(const BenchOptions& o) {
-    if (o.points < 1) {
-        printError("--points must be at least 1");
+    if (o.points < 1 || o.points > kMaxBenchPoints) {
+        printError("--points must be from 1 to " + std::to_string(kMaxBenchPoints) +
+                   " (the points and results are held in memory: 10^8 take several GB)");
         return kExitUsage;
     }
     if (o.repeat < 0 || o.threads < 0) {

@@ -91,6 +91,7 @@ struct SampleOptions {
     int threads = 0;        // 0: all hardware threads
     std::string output;     // -o OUT ("-" or empty: stdout)
     std::string format;     // vdb | npy | csv (empty: from -o, else csv)
+    bool resume = false;    // --frames: skip frames whose file is already on disk
 };
 
 // `gale viz` (cli/viz_command.cpp).
@@ -153,6 +154,7 @@ struct WedgeOptions {
     int jobs = 1;                  // variants run at once locally
     bool emitOnly = false;
     int threads = 1;               // each simulation's --threads
+    std::vector<std::string> allowPaths; // --allow-path DIR, passed on to every variant's sim
 };
 int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);

@@ -154,7 +154,7 @@ int wantWidthFor(const std::string& type) {
 
 Bindings::Bindings(double t, double frame, double fps) {
     static const double kOrigin[3] = {0.0, 0.0, 0.0};
-    for (const lang::HostVariable& v : runtime::standardVariables()) mVariables.push_back(v);
+    for (const lang::HostVariable& v : runtime::standardVariables()) declare(v.name, v.type);
     setVarying("P", 3, kOrigin, 0, 1);
     setUniform("t", {t});
     setUniform("frame", {frame});
@@ -163,15 +163,17 @@ Bindings::Bindings(double t, double frame, double fps) {
 }
 
 void Bindings::declare(const std::string& name, lang::Type type) {
-    for (lang::HostVariable& v : mVariables)
-        if (v.name == name) {
-            v.type = type;
-            return;
-        }
+    // By index, not a scan: 10^5 parameters must not take quadratic time.
+    const auto [at, fresh] = mIndex.emplace(name, mVariables.size());
+    if (!fresh) {
+        mVariables[at->second].type = type;
+        return;
+    }
     mVariables.push_back({name, type});
 }
 
 void Bindings::forget(const std::string& name) {
+    if (mBound.insert(name).second) return; // never bound: nothing to drop
     for (size_t i = mUniforms.size(); i-- > 0;)
         if (mUniforms[i].name == name)
             mUniforms.erase(mUniforms.begin() + static_cast<std::ptrdiff_t>(i));
@@ -379,7 +381,7 @@ bool parseFrames(const std::string& text, int& a, int& b) {
     } catch (...) {
         return false;
     }
-    return b >= a;
+    return b >= a && static_cast<long>(b) - a < kMaxFrames;
 }
 
 } // namespace gale::cli

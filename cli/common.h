@@ -11,6 +11,8 @@
 #include <deque>
 #include <memory>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace CLI {
@@ -77,6 +79,8 @@ private:
     std::vector<runtime::UniformValue> mUniforms;
     std::vector<runtime::VaryingInput> mVaryings;
     std::deque<std::vector<double>> mStorage;
+    std::unordered_map<std::string, size_t> mIndex; // name -> index in mVariables
+    std::unordered_set<std::string> mBound;         // names with a uniform or varying value
 };
 
 // Compiles `source` against the field layer's built-ins (the standard ones plus gust, fftturb,
@@ -106,7 +110,12 @@ std::string formatValue(double v, bool asFloat);
 // returns kExitIo on failure.
 int writeTextFileAtomic(const std::string& path, const std::string& text);
 
-// `--frames A:B` of sim and wedge: two whole numbers, A <= B (a single frame is refused).
+// The most frames one --frames range may span (sample, viz, sim, wedge): 100000 is over an hour
+// at 24 fps; a longer run is split into several.
+constexpr long kMaxFrames = 100'000;
+
+// `--frames A:B` of sim and wedge: two whole numbers, A <= B, at most kMaxFrames frames (a
+// single frame is refused).
 bool parseFrames(const std::string& text, int& a, int& b);
 
 // A JSON string literal (the point-set writer's escaping, so every JSON gale writes agrees).

@@ -4,14 +4,20 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/field_input.h"
+#include "fields/atomic_file.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
 
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
+#include <unistd.h>
 
 namespace gale::cli {
 
@@ -95,11 +101,10 @@ int writeValueLine(const EvalOptions& o, std::string line) {
     return std::cout ? kExitOk : kExitIo;
 }
 
-// Writes the points with the result columns (point-major `values`, `width` per point) added,
-// replacing columns of the same names.
-int writePointResults(const EvalOptions& o, fields::PointSet& points,
-                      const std::vector<double>& values, int width, bool asFloat,
-                      fields::PointFormat format) {
+// Adds the result columns (point-major `values`, `width` per point) to the points, replacing
+// columns of the same names; returns their indices.
+std::vector<int> addResultColumns(fields::PointSet& points, const std::vector<double>& values,
+                                  int width, bool asFloat) {
     std::vector<int> added;
     for (const std::string& name : resultColumns(width)) added.push_back(points.addColumn(name));
     if (points.float32.size() < points.names.size())
@@ -112,6 +117,15 @@ int writePointResults(const EvalOptions& o, fields::PointSet& points,
             col[i] = values[i * static_cast<size_t>(width) + static_cast<size_t>(k)];
         points.float32[static_cast<size_t>(added[static_cast<size_t>(k)])] = asFloat;
     }
+    return added;
+}
+
+// Writes the points with the result columns (point-major `values`, `width` per point) added,
+// replacing columns of the same names.
+int writePointResults(const EvalOptions& o, fields::PointSet& points,
+                      const std::vector<double>& values, int width, bool asFloat,
+                      fields::PointFormat format) {
+    const std::vector<int> added = addResultColumns(points, values, width, asFloat);
     const std::vector<int> npyColumns =
         format == fields::PointFormat::Npy ? added : std::vector<int>{};
     if (o.output.empty() || o.output == "-") {
@@ -131,9 +145,8 @@ int writePointResults(const EvalOptions& o, fields::PointSet& points,
     return kExitOk;
 }
 
-// Reads --points and checks for x, y, z; returns an exit code.
-int loadEvalPoints(const std::string& path, fields::PointSet& points) {
-    if (int rc = loadPoints(path, points)) return rc;
+// Checks that the points (or a CSV header) have x, y, z columns; returns an exit code.
+int checkXyz(const std::string& path, const fields::PointSet& points) {
     if (points.find("x") < 0 || points.find("y") < 0 || points.find("z") < 0) {
         std::string have;
         for (const std::string& n : points.names) have += (have.empty() ? "" : ", ") + n;
@@ -142,6 +155,128 @@ int loadEvalPoints(const std::string& path, fields::PointSet& points) {
                   << (have.empty() ? std::string("none") : have) << ")\n";
         return kExitInput;
     }
+    return kExitOk;
+}
+
+// Reads --points and checks for x, y, z; returns an exit code.
+int loadEvalPoints(const std::string& path, fields::PointSet& points) {
+    if (int rc = loadPoints(path, points)) return rc;
+    return checkXyz(path, points);
+}
+
+// ---- streaming: CSV points in, CSV out, a chunk at a time (memory bounded by the chunk) ----
+
+constexpr size_t kStreamChunk = size_t(1) << 20; // points per chunk
+
+// Points stream when they are read from CSV and written as CSV, unless --checked output goes to
+// stdout (a non-finite value found late must leave no output, and stdout cannot be taken back).
+bool streamsPoints(const EvalOptions& o, fields::PointFormat format) {
+    fields::PointFormat in = fields::PointFormat::Csv;
+    if (o.points != "-" && !fields::formatFromPath(o.points, in)) return false;
+    const bool toStdout = o.output.empty() || o.output == "-";
+    return in == fields::PointFormat::Csv && format == fields::PointFormat::Csv &&
+           !(o.checked && toStdout);
+}
+
+struct PointStream {
+    std::ifstream file;
+    std::unique_ptr<fields::CsvPointReader> reader;
+    fields::PointSet header; // the columns, no rows
+};
+
+int printIoError(const fields::IoError& e) {
+    std::cerr << e.render() << '\n';
+    return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+}
+
+// Opens --points and reads its header (which must name x, y and z); returns an exit code.
+int openPointStream(const std::string& path, PointStream& s) {
+    std::istream* in = &std::cin;
+    std::string name = "<stdin>";
+    if (path == "-") {
+        // std::cin is synchronised with C stdio and reads a character at a time (3x slower
+        // here); its own descriptor, reopened, is buffered. std::cin is the fallback (a socket).
+        // A regular file reopened starts at 0: continue where standard input stands.
+        const off_t at = ::lseek(0, 0, SEEK_CUR);
+        s.file.open("/dev/stdin", std::ios::binary);
+        if (s.file && at > 0) s.file.seekg(at);
+        if (s.file) in = &s.file;
+    } else {
+        name = path;
+        std::error_code ec;
+        if (std::filesystem::is_directory(path, ec))
+            return printIoError(fields::ioErrorAt(path, "cannot read", EISDIR));
+        errno = 0;
+        s.file.open(path, std::ios::binary);
+        if (!s.file) return printIoError(fields::ioErrorAt(path, "cannot open", errno));
+        in = &s.file;
+    }
+    s.reader = std::make_unique<fields::CsvPointReader>(*in, name);
+    if (fields::IoError e = s.reader->readHeader(s.header)) return printIoError(e);
+    return checkXyz(path, s.header);
+}
+
+// Evaluates one chunk (points first .. first + chunk.size() - 1) and adds its result columns;
+// adds the number of points with a non-finite result to `bad` (--checked); returns an exit code.
+using ChunkEval = std::function<int(fields::PointSet& chunk, size_t first, size_t& bad)>;
+
+// Reads, evaluates and writes chunk after chunk. After a chunk with non-finite results
+// (--checked) the rest is still evaluated, to count them, but nothing more is written and the
+// output file is not created: `reportBad(bad, total)` gives the exit code.
+int streamPoints(const EvalOptions& o, PointStream& s, const ChunkEval& eval,
+                 const std::function<int(size_t bad, size_t total)>& reportBad) {
+    fields::IoError writeError;
+    auto run = [&](std::ostream* out) -> int {
+        fields::PointSet chunk;
+        size_t total = 0, bad = 0;
+        for (bool first = true;; first = false) {
+            if (fields::IoError e = s.reader->readRows(chunk, kStreamChunk)) return printIoError(e);
+            const size_t n = chunk.size();
+            if (n == 0 && !first) break;
+            if (int rc = eval(chunk, total, bad)) return rc;
+            total += n;
+            if (bad > 0) out = nullptr;
+            if (out) {
+                writeError = fields::writePointsCsv(*out, chunk, first);
+                if (writeError) return kExitIo;
+            }
+            if (n == 0) break;
+        }
+        return bad > 0 ? reportBad(bad, total) : kExitOk;
+    };
+    if (o.output.empty() || o.output == "-") {
+        const int rc = run(&std::cout);
+        std::cout.flush();
+        if (rc == kExitIo && writeError) {
+            printError("cannot write to stdout: " + writeError.message);
+            return kExitIo;
+        }
+        if (rc == kExitOk && !std::cout) {
+            printError("cannot write to stdout");
+            return kExitIo;
+        }
+        return rc;
+    }
+    int rc = kExitOk;
+    fields::IoError e = fields::writeFileAtomic(o.output, [&](const std::string& tmp) -> fields::IoError {
+        errno = 0;
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        if (!f) return fields::ioErrorAt(o.output, "cannot write", errno);
+        rc = run(&f);
+        if (rc == kExitIo && writeError) return fields::ioErrorAt(o.output, "cannot write", errno);
+        if (rc) { // already reported; the temporary file is removed
+            fields::IoError stop;
+            stop.kind = fields::IoError::Data;
+            return stop;
+        }
+        f.flush();
+        const int err = errno;
+        f.close();
+        if (f.fail()) return fields::ioErrorAt(o.output, "cannot write", err);
+        return fields::IoError{};
+    });
+    if (rc && !(rc == kExitIo && writeError)) return rc;
+    if (e) return printIoError(e);
     return kExitOk;
 }
 
@@ -182,15 +317,49 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
     if (!report.empty()) std::cerr << report << std::flush;
     if (!field) return kExitInput;
 
-    fields::PointSet points;
-    if (havePoints) {
-        if (int rc = loadEvalPoints(o.points, points)) return rc;
-    }
     const double fps = fpsGiven ? o.fps : scene.settings.fps;
     fields::SampleTime when;
     when.fps = fps;
     when.time = o.hasTime ? o.time : o.hasFrame ? o.frame / fps : 0.0;
     when.threads = o.threads >= 0 ? o.threads : havePoints ? 0 : 1;
+    if (havePoints && streamsPoints(o, format)) {
+        PointStream stream;
+        if (int rc = openPointStream(o.points, stream)) return rc;
+        std::vector<double> positions, velocities;
+        auto eval = [&](fields::PointSet& chunk, size_t, size_t& bad) -> int {
+            const size_t n = chunk.size();
+            positions.assign(3 * n, 0.0);
+            const int axes[3] = {chunk.find("x"), chunk.find("y"), chunk.find("z")};
+            for (int k = 0; k < 3; ++k) {
+                const std::vector<double>& col = chunk.columns[static_cast<size_t>(axes[k])];
+                for (size_t i = 0; i < n; ++i) positions[3 * i + static_cast<size_t>(k)] = col[i];
+            }
+            velocities.assign(3 * n, 0.0);
+            fields::SampleStatus status =
+                field->sample(positions.data(), n, when, velocities.data());
+            if (!status.ok) {
+                printError("cannot evaluate " + o.source.file + ": " + status.message);
+                return kExitInput;
+            }
+            if (status.nonFinite > 0) {
+                if (o.checked)
+                    bad += status.nonFinite;
+                else
+                    printError("warning: " + status.message);
+            }
+            addResultColumns(chunk, velocities, 3, asFloat);
+            return kExitOk;
+        };
+        return streamPoints(o, stream, eval, [](size_t bad, size_t total) {
+            printError(std::to_string(bad) + " of " + std::to_string(total) +
+                       " point(s) gave a non-finite velocity; nothing was written");
+            return kExitNumeric;
+        });
+    }
+    fields::PointSet points;
+    if (havePoints) {
+        if (int rc = loadEvalPoints(o.points, points)) return rc;
+    }
     const size_t n = havePoints ? points.size() : 1;
     std::vector<double> positions(3 * n, 0.0);
     if (havePoints) {
@@ -265,8 +434,13 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     const double t = o.hasTime ? o.time : o.hasFrame ? o.frame / o.fps : 0.0;
     const double frame = o.hasFrame ? o.frame : t * o.fps;
 
+    const bool stream = havePoints && streamsPoints(o, format);
+    PointStream pointStream;
     fields::PointSet points;
-    if (havePoints) {
+    if (stream) {
+        if (int rc = openPointStream(o.points, pointStream)) return rc;
+        points = pointStream.header; // no rows: the columns give the variables' types
+    } else if (havePoints) {
         if (int rc = loadEvalPoints(o.points, points)) return rc;
     }
     Bindings bindings(t, frame, o.fps);
@@ -289,15 +463,59 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
         return kExitInput;
     }
 
+    // One value (no --points) is evaluated in double unless asked otherwise: speed is moot
+    // there, and double gives SeExpr2's numbers exactly. Point sets default to float.
+    const bool asFloat = o.precision.empty() ? havePoints : o.precision == "float";
+    const int width = program->resultIsString() ? 1 : program->resultWidth();
+    if (stream) {
+        std::vector<double> ids, values;
+        std::vector<std::string> strings;
+        runtime::EvalResult firstBad; // --checked: the evaluation that found the first one
+        const std::vector<fields::ParameterDecl> params = fields::findParameters(source);
+        auto eval = [&](fields::PointSet& chunk, size_t first, size_t& bad) -> int {
+            const size_t n = chunk.size();
+            ids.resize(n);
+            for (size_t i = 0; i < n; ++i) ids[i] = static_cast<double>(first + i);
+            Bindings b(t, frame, o.fps);
+            b.setVarying("id", 1, ids.data(), 1, 1); // the point's index in the whole file
+            b.addPoints(chunk);
+            for (const fields::ParameterDecl& p : params) b.setUniform(p.name, p.defaultValue);
+            b.addSets(sets); // (the order of bindParameters: columns, parameters, --set)
+            runtime::EvalRequest request;
+            request.count = n;
+            b.fillRequest(request);
+            request.threads = o.threads >= 0 ? o.threads : 0;
+            request.checked = o.checked;
+            runtime::EvalResult r =
+                asFloat ? evaluateInto<float>(*program, request, width, values, strings)
+                        : evaluateInto<double>(*program, request, width, values, strings);
+            if (!r.messages.empty()) std::cerr << r.messages << std::flush;
+            if (!r.ok) {
+                printError("cannot evaluate " + source.name() + ": " + r.error);
+                return kExitInput;
+            }
+            if (r.nonFinite > 0) {
+                const size_t count = r.nonFinite;
+                if (bad == 0) {
+                    firstBad = std::move(r);
+                    firstBad.firstBadPoint += first;
+                }
+                bad += count;
+            }
+            addResultColumns(chunk, values, width, asFloat);
+            return kExitOk;
+        };
+        return streamPoints(o, pointStream, eval, [&](size_t bad, size_t total) {
+            firstBad.nonFinite = bad;
+            return reportNonFinite(source, firstBad, total);
+        });
+    }
+
     runtime::EvalRequest request;
     request.count = havePoints ? points.size() : 1;
     bindings.fillRequest(request);
     request.threads = o.threads >= 0 ? o.threads : havePoints ? 0 : 1;
     request.checked = o.checked;
-    // One value (no --points) is evaluated in double unless asked otherwise: speed is moot
-    // there, and double gives SeExpr2's numbers exactly. Point sets default to float.
-    const bool asFloat = o.precision.empty() ? havePoints : o.precision == "float";
-    const int width = program->resultIsString() ? 1 : program->resultWidth();
     std::vector<double> values;
     std::vector<std::string> strings;
     runtime::EvalResult r = asFloat

@@ -198,6 +198,11 @@ bool parseFrameRange(const std::string& text, long& first, long& last, std::stri
         error = "--frames '" + text + "': the last frame comes before the first";
         return false;
     }
+    if (last - first >= kMaxFrames) {
+        error = "--frames '" + text + "': more than " + std::to_string(kMaxFrames) +
+                " frames; split the range into several runs";
+        return false;
+    }
     return true;
 }
 

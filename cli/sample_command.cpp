@@ -8,8 +8,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <unistd.h>
@@ -94,6 +96,27 @@ int writeOutput(const SampleOptions& o, const std::string& path, fields::GridFor
     return kExitOk;
 }
 
+// Removes the temporary files of frames that a killed run was writing (`wind.0007.vdb.tmp.<pid>`
+// of a process that no longer runs): names of the --frames pattern only.
+void removeStaleFrameTemps(const std::string& pattern) {
+    namespace fs = std::filesystem;
+    const fs::path p(pattern);
+    const std::string folder = p.parent_path().string(), name = p.filename().string();
+    const size_t first = name.find('#');
+    if (first == std::string::npos || folder.find('#') != std::string::npos) return;
+    const size_t end = name.find_first_not_of('#', first);
+    const std::string head = name.substr(0, first), tail = end == std::string::npos ? "" : name.substr(end);
+    fields::removeStaleTempFiles(folder, [&](const std::string& target) {
+        if (target.size() <= head.size() + tail.size() || target.compare(0, head.size(), head) != 0 ||
+            target.compare(target.size() - tail.size(), tail.size(), tail) != 0)
+            return false;
+        const std::string middle = target.substr(head.size(), target.size() - head.size() - tail.size());
+        for (size_t i = 0; i < middle.size(); ++i)
+            if (!std::isdigit(static_cast<unsigned char>(middle[i])) && !(i == 0 && middle[i] == '-')) return false;
+        return true;
+    });
+}
+
 std::string describeTime(double t, double frame, bool frames) {
     return frames ? "frame " + formatValue(frame, false) + " (t = " + formatValue(t, false) + " s)"
                   : "t = " + formatValue(t, false) + " s";
@@ -165,16 +188,34 @@ int runSample(const SampleOptions& o) {
         }
     }
 
+    if (o.resume && !frames) {
+        printError("--resume continues a --frames sequence: give --frames A:B and the same -o pattern");
+        return kExitUsage;
+    }
+
     FieldInput input;
     if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
+    if (frames) removeStaleFrameTemps(o.output);
 
     Progress progress(::isatty(STDERR_FILENO) != 0);
     fields::GridSampleOptions sampling;
     sampling.threads = o.threads;
     std::vector<float> values;
     const long count = frames ? lastFrame - firstFrame + 1 : 1;
+    long skipped = 0;
     for (long n = 0; n < count; ++n) {
         const long f = firstFrame + n;
+        if (o.resume) {
+            // Frames are written whole or not at all (temporary name, then rename), so a frame
+            // file on disk is complete (an empty one, left by a crash of the machine, is redone).
+            std::string path;
+            fields::framePath(o.output, f, path);
+            std::error_code ec;
+            if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) > 0 && !ec) {
+                ++skipped;
+                continue;
+            }
+        }
         fields::SampleTime when;
         when.fps = input.fps;
         when.time = frames ? static_cast<double>(f) / input.fps : o.time;
@@ -207,6 +248,9 @@ int runSample(const SampleOptions& o) {
         if (int rc = writeOutput(o, path, format, grid, values, input, when.time, frameNumber))
             return rc;
     }
+    if (skipped > 0)
+        std::cerr << "gale: --resume: " << skipped << " of " << count
+                  << " frame(s) already on disk, skipped\n";
     return kExitOk;
 }
 
@@ -243,6 +287,10 @@ Command addSampleCommand(CLI::App& app) {
             ->type_name("A:B");
     time->excludes(frames);
     frames->excludes(time);
+    sub->add_flag("--resume", o->resume,
+                  "With --frames: skip the frames whose file is already on disk (each is whole: "
+                  "written under a temporary name, then renamed) and write the missing ones, as "
+                  "after an interrupted run; give the same source, grid and -o pattern");
     sub->add_option("--fps", o->fps, "Frames per second (default: the scene's, else 24)")
         ->type_name("FPS");
     sub->add_option("--threads", o->threads,

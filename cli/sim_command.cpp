@@ -9,10 +9,14 @@
 #include "solver/scene.h"
 
 #include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -46,7 +50,9 @@ const char* solverName(solver::LinearSolverKind k) { return k == solver::LinearS
 std::string stepJson(const solver::StepOptions& s) {
     return "\"linear_solver\": \"" + std::string(solverName(s.linearSolver)) + "\", \"cg_tolerance\": " +
            num(s.cgTolerance) + ", \"cg_max_iterations\": " + std::to_string(s.cgMaxIterations) +
-           ", \"newton_iterations\": " + std::to_string(s.newtonIterations);
+           ", \"preconditioner\": \"" +
+           (s.preconditioner == solver::Preconditioner::Multigrid ? "multigrid" : "jacobi") +
+           "\", \"newton_iterations\": " + std::to_string(s.newtonIterations);
 }
 
 // The settings as resolved (after --set), for run.json and to check that --resume continues
@@ -194,6 +200,53 @@ int writeFrame(const solver::SimScene& sc, const solver::World& w, const std::st
     return kExitOk;
 }
 
+// Takes an exclusive lock on OUTDIR/.state/lock for the rest of the process (the kernel drops it
+// when the process ends, even killed), so two runs never write one folder at once: a wedge
+// re-run while the simulations of a killed wedge still run, two farm tasks on one variant.
+int lockOutput(const std::string& dir) {
+    const std::string path = (fs::path(dir) / ".state" / "lock").string();
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        printError(path + ": cannot create the lock file: " + std::strerror(errno));
+        return kExitIo;
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        const int err = errno;
+        char buf[32] = {};
+        const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+        const std::string pid = n > 0 ? std::string(buf, static_cast<size_t>(n)) : std::string();
+        if (err != EWOULDBLOCK) return kExitOk; // no locks on this file system: run unguarded
+        ::close(fd);
+        printError(dir + " is being written by another gale sim" + (pid.empty() ? std::string() : " (pid " + pid + ")") +
+                   "; wait for it to finish or stop it, then run again (with --resume to continue its frames)");
+        return kExitIo;
+    }
+    const std::string pid = std::to_string(static_cast<long>(::getpid()));
+    // The pid only names the holder in the message above; the lock holds without it.
+    const bool noted = ::pwrite(fd, pid.data(), pid.size(), 0) == static_cast<ssize_t>(pid.size()) &&
+                       ::ftruncate(fd, static_cast<off_t>(pid.size())) == 0;
+    (void)noted;
+    return kExitOk; // fd stays open (and locked) until the process ends
+}
+
+// Removes the temporary files a killed run left (a frame, run.json or state being written).
+void removeStaleTemps(const std::string& dir, const solver::World& w) {
+    std::vector<std::string> names;
+    for (const auto& b : w.bodies()) names.push_back(b->name() + ".");
+    auto endsWith = [](const std::string& s, const char* tail) {
+        const size_t n = std::strlen(tail);
+        return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
+    };
+    fields::removeStaleTempFiles(dir, [&](const std::string& target) {
+        if (target == "run.json") return true;
+        if (!endsWith(target, ".obj") && !endsWith(target, ".ply")) return false;
+        for (const std::string& n : names)
+            if (target.compare(0, n.size(), n) == 0) return true;
+        return false;
+    });
+    fields::removeStaleTempFiles((fs::path(dir) / ".state").string(), [](const std::string&) { return true; });
+}
+
 class Progress {
 public:
     explicit Progress(int total) : mTotal(total), mOn(isatty(2) != 0), mStart(std::chrono::steady_clock::now()) {}
@@ -229,7 +282,8 @@ int runSim(const SimOptions& o) {
     int first = 0, last = 0;
     const bool frameRange = !o.frames.empty();
     if (frameRange && !parseFrames(o.frames, first, last)) {
-        printError("--frames must be A:B with whole numbers A <= B, not '" + o.frames + "'");
+        printError("--frames must be A:B with whole numbers A <= B, at most " +
+                       std::to_string(kMaxFrames) + " frames, not '" + o.frames + "'");
         return kExitUsage;
     }
 
@@ -253,7 +307,7 @@ int runSim(const SimOptions& o) {
     if (!wind) return kExitInput;
     std::vector<std::unique_ptr<Body>> bodies;
     std::vector<std::string> warnings;
-    if (!solver::buildBodies(scene, bodies, errors, warnings)) return report(errors);
+    if (!solver::buildBodies(scene, bodies, errors, warnings, o.allowPaths)) return report(errors);
     for (const std::string& w : warnings) std::cerr << "gale: warning: " << w << '\n';
     if (bodies.empty()) {
         printError(o.scene + ": the scene has no [[cloth]] or [[hair]] to simulate");
@@ -276,6 +330,8 @@ int runSim(const SimOptions& o) {
         printError(o.output + ": cannot create the output folder: " + ec.message());
         return kExitIo;
     }
+    if (int rc = lockOutput(o.output)) return rc;
+    removeStaleTemps(o.output, world);
 
     // --resume: the last frame whose state and stats were saved, by this same run.
     std::vector<std::string> frames;
@@ -293,8 +349,11 @@ int runSim(const SimOptions& o) {
             if (readFile(stateFile(o.output, f, "bin"), st) && readFile(stateFile(o.output, f, "json"), js)) {
                 std::string error;
                 if (!world.loadState(st, error)) {
-                    printError(stateFile(o.output, f, "bin") + ": " + error);
-                    return kExitInput;
+                    // Damaged (a crash of the machine rather than of gale): an earlier frame's
+                    // state gives the same frames, only later.
+                    std::cerr << "gale: warning: " << stateFile(o.output, f, "bin") << ": " << error
+                              << "; resuming from an earlier frame\n";
+                    continue;
                 }
                 resumeAt = f;
             }
@@ -311,6 +370,13 @@ int runSim(const SimOptions& o) {
             start = resumeAt + 1;
             std::cerr << "gale: resuming after frame " << resumeAt << '\n';
         }
+    }
+    if (start == first) {
+        // Starting over: the states of an earlier run must not be resumed with this run's frames.
+        std::vector<fs::path> old;
+        for (fs::directory_iterator it(fs::path(o.output) / ".state", ec), end; !ec && it != end; it.increment(ec))
+            if (it->path().filename() != "lock") old.push_back(it->path());
+        for (const fs::path& p : old) fs::remove(p, ec);
     }
     if (int rc = writeBytes((fs::path(o.output) / ".state" / "settings.json").string(), settings)) return rc;
 
@@ -372,7 +438,8 @@ Command addSimCommand(CLI::App& app) {
     CLI::App* sub = app.add_subcommand(
         "sim", "Simulate the scene's cloth and hair in its wind: writes OUTDIR/<object>.<frame>.obj|ply per "
                "frame, OUTDIR/run.json (settings as resolved, per-frame stats) and the solver state per frame "
-               "for --resume. Exit 4 when the run failed numerically.");
+               "for --resume; one run at a time per OUTDIR (a second is refused, exit 3). Exit 4 when the run "
+               "failed numerically.");
     sub->add_option("scene", o->scene, "Scene file (.toml) with [[cloth]] and/or [[hair]]")
         ->type_name("SCENE")
         ->required();

@@ -191,9 +191,11 @@ std::string shellQuote(const std::string& text) {
     return out + "'";
 }
 
-std::string taskCommand(const std::string& galeBinary, const std::string& variantDir, int threads) {
+std::string taskCommand(const std::string& galeBinary, const std::string& variantDir, int threads,
+                        const std::vector<std::string>& allowPaths) {
     std::string sim = shellQuote(galeBinary) + " sim scene.toml -o . --resume";
     if (threads != 1) sim += " --threads " + std::to_string(threads);
+    for (const std::string& dir : allowPaths) sim += " --allow-path " + shellQuote(dir);
     return "cd " + shellQuote(variantDir) + " && if [ ! -f DONE ]; then " + sim +
            " >> log.txt 2>&1 && touch DONE; fi";
 }

@@ -77,7 +77,8 @@ int runWedge(const WedgeOptions& o) {
     if (!o.frames.empty()) {
         int a = 0, b = 0;
         if (!parseFrames(o.frames, a, b)) {
-            printError("--frames must be A:B with whole numbers A <= B, not '" + o.frames + "'");
+            printError("--frames must be A:B with whole numbers A <= B, at most " +
+                       std::to_string(kMaxFrames) + " frames, not '" + o.frames + "'");
             return kExitUsage;
         }
         common.push_back("scene.frames=[" + std::to_string(a) + ", " + std::to_string(b) + "]");
@@ -124,6 +125,12 @@ int runWedge(const WedgeOptions& o) {
     }
     const std::string gale = selfPath();
     const std::string sceneAbs = fs::absolute(o.scene, ec).lexically_normal().string();
+    // A variant's scene lives in its own folder, so the folder the expressions could reach from
+    // the original scene is allowed explicitly, with every --allow-path (absolute: the task runs
+    // in the variant folder).
+    std::vector<std::string> allowPaths = {fs::path(sceneAbs).parent_path().string()};
+    for (const std::string& dir : o.allowPaths)
+        allowPaths.push_back(fs::absolute(dir, ec).lexically_normal().string());
     std::vector<std::string> commands, status(variants.size()), dirs;
     std::string tasks;
     int restarted = 0;
@@ -151,7 +158,7 @@ int runWedge(const WedgeOptions& o) {
             ++restarted;
         }
         if (int rc = writeTextFileAtomic((dir / "scene.toml").string(), text)) return rc;
-        commands.push_back(taskCommand(gale, dir.string(), o.threads));
+        commands.push_back(taskCommand(gale, dir.string(), o.threads, allowPaths));
         tasks += commands.back() + '\n';
     }
     if (int rc = writeTextFileAtomic((out / "tasks.txt").string(), tasks)) return rc;
@@ -246,6 +253,7 @@ Command addWedgeCommand(CLI::App& app) {
                                       "on a farm; running gale wedge again refreshes the manifest's status)");
     jobs->excludes(emit);
     sub->add_option("--threads", o->threads, "Threads of each simulation (default 1; 0: all)")->type_name("N");
+    addAllowPathOption(*sub, o->allowPaths);
     sub->footer("Re-running skips variants already complete (DONE marker and every frame present) and resumes\n"
                 "interrupted ones. Exit codes: 1 a variant's scene is wrong (nothing written) or a variant\n"
                 "failed to load when run, 2 bad flags, 3 I/O error, 4 a variant failed numerically; with\n"

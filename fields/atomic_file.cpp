@@ -1,11 +1,13 @@
 // Atomic file writes: temporary name + rename, with devices, pipes and symbolic links handled.
 #include "fields/atomic_file.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <signal.h>
 #include <unistd.h>
 
 namespace gale::fields {
@@ -61,6 +63,45 @@ IoError writeBytesAtomic(const std::string& path, const std::string& bytes) {
         if (f.fail()) return ioErrorAt(path, "cannot write", err);
         return {};
     });
+}
+
+namespace {
+
+// Whether process `pid` exists and is not a zombie (killed, its exit not yet collected): kill(pid,
+// 0) fails with ESRCH only when no such process exists (EPERM: it runs as another user).
+bool processRuns(long pid) {
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) return false;
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string text;
+    if (!stat || !std::getline(stat, text)) return true;
+    const size_t paren = text.rfind(')'); // the state follows "pid (name)"
+    return paren == std::string::npos || paren + 2 >= text.size() ||
+           (text[paren + 2] != 'Z' && text[paren + 2] != 'X');
+}
+
+} // namespace
+
+std::vector<std::string> removeStaleTempFiles(const std::string& folder,
+                                              const std::function<bool(const std::string& target)>& isOurs) {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> stale;
+    std::error_code ec;
+    for (fs::directory_iterator it(folder.empty() ? "." : folder, ec), end; !ec && it != end; it.increment(ec)) {
+        if (!it->is_regular_file(ec)) continue;
+        const std::string name = it->path().filename().string();
+        const size_t mark = name.rfind(".tmp.");
+        if (mark == std::string::npos || mark == 0 || mark + 5 == name.size() || name.size() - mark - 5 > 9) continue;
+        bool digits = true;
+        for (size_t i = mark + 5; i < name.size(); ++i) digits = digits && std::isdigit(static_cast<unsigned char>(name[i]));
+        if (!digits) continue;
+        const long pid = std::stol(name.substr(mark + 5));
+        if (pid <= 0 || pid == static_cast<long>(::getpid()) || processRuns(pid)) continue;
+        if (isOurs(name.substr(0, mark))) stale.push_back(it->path());
+    }
+    std::vector<std::string> removed;
+    for (const fs::path& p : stale)
+        if (fs::remove(p, ec)) removed.push_back(p.string());
+    return removed;
 }
 
 } // namespace gale::fields

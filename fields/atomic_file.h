@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace gale::fields {
 
@@ -17,6 +18,12 @@ IoError writeFileAtomic(const std::string& path,
 
 // The same for a block of bytes already in memory.
 IoError writeBytesAtomic(const std::string& path, const std::string& bytes);
+
+// The temporary files that writes killed part-way (SIGKILL, a crash) left in `folder`:
+// `<target>.tmp.<pid>` where no process `pid` is running and `isOurs(target)` holds for the
+// target's file name. Removes them and returns their paths; files of running writers are kept.
+std::vector<std::string> removeStaleTempFiles(const std::string& folder,
+                                              const std::function<bool(const std::string& target)>& isOurs);
 
 // An Io error for `file`: "what: strerror(err)".
 IoError ioErrorAt(const std::string& file, const std::string& what, int err);

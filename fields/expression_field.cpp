@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <unordered_set>
 
 namespace gale::fields {
 
@@ -104,6 +105,7 @@ std::vector<ParameterDecl> findParameters(const lang::SourceFile& source) {
         return i + 1;
     };
 
+    std::unordered_set<std::string> seen; // names in `out`
     int depth = 0;              // (), [], {} nesting
     bool statementStart = true; // the previous token ended a statement (or there is none)
     for (size_t i = 0; i < tokens.size(); ++i) {
@@ -135,8 +137,7 @@ std::vector<ParameterDecl> findParameters(const lang::SourceFile& source) {
                 j = number(j, v);
                 if (j) decl.defaultValue.push_back(v);
             }
-            const bool known = std::any_of(out.begin(), out.end(),
-                                           [&](const ParameterDecl& d) { return d.name == decl.name; });
+            const bool known = seen.count(decl.name) > 0; // (a set: 10^5 parameters stay fast)
             if (j && kindAt(j) == TokenKind::Semicolon && !isHostName(decl.name) && !known &&
                 decl.defaultValue.size() <= static_cast<size_t>(lang::kMaxWidth)) {
                 decl.span = {tokens[i].span.begin, tokens[j].span.end};
@@ -144,6 +145,7 @@ std::vector<ParameterDecl> findParameters(const lang::SourceFile& source) {
                 decl.line = static_cast<int>(source.lineCol(tokens[i].span.begin).line);
                 std::string_view line = source.lineText(end.line);
                 parseRangeComment(line.substr(std::min<size_t>(end.col - 1, line.size())), decl);
+                seen.insert(decl.name);
                 out.push_back(std::move(decl));
                 i = j;
                 statementStart = true;
@@ -197,7 +199,7 @@ std::shared_ptr<ExpressionField> ExpressionField::compile(const lang::SourceFile
     bool ok = true;
     for (const auto& [name, param] : options.params) {
         auto it = std::find_if(field->mParameters.begin(), field->mParameters.end(),
-                               [&](const ParameterDecl& p) { return p.name == name; });
+                               [&name = name](const ParameterDecl& p) { return p.name == name; });
         if (it == field->mParameters.end()) {
             sink.error({0, 0}, "'" + name + "' is not a parameter of " + source.name());
             std::string_view close = lang::closestName(name, names);

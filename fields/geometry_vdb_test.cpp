@@ -249,7 +249,10 @@ TEST_CASE("vdb() errors: missing, truncated, garbage and wrong-grid files", "[ge
     std::string d = compileError(dir, "vdb(\"missing.vdb\", \"vel\", $P)");
     CHECK(d.find("expr.se:1:5: error: cannot read 'missing.vdb'") != std::string::npos);
 
-    // Truncated: the first half of a good file.
+    // Truncated: the first half of a good file. Not under AddressSanitizer: OpenVDB 10 reads a
+    // block size the short stream never delivered and asks new[] for that (garbage) many bytes;
+    // std::bad_alloc normally, an abort under ASan. See docs/sanitizers.md.
+#ifndef __SANITIZE_ADDRESS__
     {
         std::ifstream in(dir.file("good.vdb"), std::ios::binary);
         std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -260,6 +263,7 @@ TEST_CASE("vdb() errors: missing, truncated, garbage and wrong-grid files", "[ge
     CHECK(d.find("trunc.vdb: cannot read the VDB file") != std::string::npos);
     std::shared_ptr<const VelocityVolume> v;
     CHECK(VelocityVolume::load(dir.file("trunc.vdb"), "vel", v).kind == IoError::Io);
+#endif
 
     std::ofstream(dir.file("text.vdb")) << "this is not a VDB file\n";
     d = compileError(dir, "vdb(\"text.vdb\", \"vel\", $P)");

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -198,65 +199,85 @@ std::string parseNumber(std::string_view text, double& v) {
 
 } // namespace
 
-IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet& out) {
+CsvPointReader::CsvPointReader(std::istream& in, std::string displayName)
+    : mIn(in), mName(std::move(displayName)) {}
+
+IoError CsvPointReader::readHeader(PointSet& out) {
     out = PointSet{};
-    std::string line;
     std::vector<Field> fields;
-    int lineNo = 0;
-    bool haveHeader = false;
-    int headerLine = 0;
-    while (std::getline(in, line)) {
-        ++lineNo;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (lineNo == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3); // BOM
-        std::string_view view(line);
+    while (std::getline(mIn, mLine)) {
+        ++mLineNo;
+        if (!mLine.empty() && mLine.back() == '\r') mLine.pop_back();
+        if (mLineNo == 1 && mLine.compare(0, 3, "\xEF\xBB\xBF") == 0) mLine.erase(0, 3); // BOM
+        std::string_view view(mLine);
         size_t first = view.find_first_not_of(" \t");
         if (first == std::string_view::npos || view[first] == '#') continue;
         splitCsv(view, fields);
-        if (!haveHeader) {
-            haveHeader = true;
-            headerLine = lineNo;
-            std::set<std::string> seen;
-            for (size_t i = 0; i < fields.size(); ++i) {
-                std::string_view name = fields[i].text;
-                if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
-                    name = name.substr(1, name.size() - 2);
-                if (name.empty())
-                    return dataError(displayName, lineNo, fields[i].col,
-                                     "empty column name (column " + std::to_string(i + 1) + ")");
-                double dummy;
-                if (parseNumber(name, dummy).empty())
-                    return dataError(displayName, lineNo, fields[i].col,
-                                     "the first line must be a header naming the columns "
-                                     "(like x,y,z), found the number '" +
-                                         std::string(name) + "'");
-                if (!seen.insert(std::string(name)).second)
-                    return dataError(displayName, lineNo, fields[i].col,
-                                     "duplicate column name '" + std::string(name) + "'");
-                out.names.emplace_back(name);
-            }
-            out.columns.resize(out.names.size());
-            continue;
+        mHeaderLine = mLineNo;
+        std::set<std::string> seen;
+        for (size_t i = 0; i < fields.size(); ++i) {
+            std::string_view name = fields[i].text;
+            if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+                name = name.substr(1, name.size() - 2);
+            if (name.empty())
+                return dataError(mName, mLineNo, fields[i].col,
+                                 "empty column name (column " + std::to_string(i + 1) + ")");
+            double dummy;
+            if (parseNumber(name, dummy).empty())
+                return dataError(mName, mLineNo, fields[i].col,
+                                 "the first line must be a header naming the columns "
+                                 "(like x,y,z), found the number '" +
+                                     std::string(name) + "'");
+            if (!seen.insert(std::string(name)).second)
+                return dataError(mName, mLineNo, fields[i].col,
+                                 "duplicate column name '" + std::string(name) + "'");
+            out.names.emplace_back(name);
         }
-        if (fields.size() != out.names.size())
-            return dataError(displayName, lineNo, 1,
+        out.columns.resize(out.names.size());
+        mNames = out.names;
+        return {};
+    }
+    if (mIn.bad()) return ioError(mName, "read failed: " + errnoText(errno));
+    return dataError(mName, 0, 0,
+                     "no header line: a CSV point file starts with the column names, e.g. x,y,z");
+}
+
+IoError CsvPointReader::readRows(PointSet& chunk, size_t maxRows) {
+    chunk.names = mNames;
+    chunk.columns.resize(mNames.size());
+    chunk.float32.clear();
+    for (std::vector<double>& column : chunk.columns) column.clear();
+    std::vector<Field> fields;
+    size_t rows = 0;
+    while (rows < maxRows && std::getline(mIn, mLine)) {
+        ++mLineNo;
+        if (!mLine.empty() && mLine.back() == '\r') mLine.pop_back();
+        std::string_view view(mLine);
+        size_t first = view.find_first_not_of(" \t");
+        if (first == std::string_view::npos || view[first] == '#') continue;
+        splitCsv(view, fields);
+        if (fields.size() != mNames.size())
+            return dataError(mName, mLineNo, 1,
                              "row has " + std::to_string(fields.size()) + " field" +
                                  (fields.size() == 1 ? "" : "s") + ", header (line " +
-                                 std::to_string(headerLine) + ") has " +
-                                 std::to_string(out.names.size()));
+                                 std::to_string(mHeaderLine) + ") has " +
+                                 std::to_string(mNames.size()));
         for (size_t i = 0; i < fields.size(); ++i) {
             double v = 0.0;
             std::string msg = parseNumber(fields[i].text, v);
-            if (!msg.empty()) return dataError(displayName, lineNo, fields[i].col, msg);
-            out.columns[i].push_back(v);
+            if (!msg.empty()) return dataError(mName, mLineNo, fields[i].col, msg);
+            chunk.columns[i].push_back(v);
         }
+        ++rows;
     }
-    if (in.bad()) return ioError(displayName, "read failed: " + errnoText(errno));
-    if (!haveHeader)
-        return dataError(
-            displayName, 0, 0,
-            "no header line: a CSV point file starts with the column names, e.g. x,y,z");
+    if (mIn.bad()) return ioError(mName, "read failed: " + errnoText(errno));
     return {};
+}
+
+IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet& out) {
+    CsvPointReader reader(in, displayName);
+    if (IoError e = reader.readHeader(out)) return e;
+    return reader.readRows(out, SIZE_MAX);
 }
 
 // ---- OBJ ----
@@ -291,6 +312,14 @@ IoError readPointsObj(const std::string& path, PointSet& out) {
             face.reserve(count);
             for (unsigned j = 0; j < count && at < shape.mesh.indices.size(); ++j, ++at)
                 face.push_back(shape.mesh.indices[at].vertex_index);
+            // As the PLY reader: a face may only name vertices that exist (else every writer
+            // would write a file that no reader accepts).
+            for (int v : face)
+                if (v < 0 || static_cast<size_t>(v) >= n)
+                    return dataError(path, 0, 0,
+                                     "face " + std::to_string(out.faces.size() + 1) + " refers to vertex " +
+                                         std::to_string(static_cast<long long>(v) + 1) + " (counting from 1), but there are " +
+                                         std::to_string(n) + " vertices: fix its f line");
             out.faces.push_back(std::move(face));
         }
     }
@@ -301,13 +330,13 @@ IoError readPointsObj(const std::string& path, PointSet& out) {
 
 namespace {
 
-IoError writeCsv(std::ostream& out, const PointSet& ps) {
+IoError writeCsv(std::ostream& out, const PointSet& ps, bool header = true) {
     std::string buf;
-    for (size_t c = 0; c < ps.names.size(); ++c) {
+    for (size_t c = 0; header && c < ps.names.size(); ++c) {
         if (c) buf += ',';
         buf += ps.names[c];
     }
-    buf += '\n';
+    if (header) buf += '\n';
     size_t n = ps.size();
     for (size_t i = 0; i < n; ++i) {
         for (size_t c = 0; c < ps.columns.size(); ++c) {
@@ -445,6 +474,12 @@ IoError writePoints(std::ostream& out, const PointSet& points, PointFormat forma
         break;
     }
     if (e) return e;
+    if (!out) return ioError("", "write failed: " + errnoText(errno));
+    return {};
+}
+
+IoError writePointsCsv(std::ostream& out, const PointSet& points, bool header) {
+    writeCsv(out, points, header);
     if (!out) return ioError("", "write failed: " + errnoText(errno));
     return {};
 }

@@ -53,6 +53,26 @@ IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet
 IoError readPointsPly(std::istream& in, const std::string& displayName, PointSet& out);
 IoError readPointsObj(const std::string& path, PointSet& out);
 
+// Reads a CSV point file a chunk of rows at a time, so a file of any length is read in
+// bounded memory; the errors (and their line numbers) are readPointsCsv's, which uses it.
+class CsvPointReader {
+public:
+    CsvPointReader(std::istream& in, std::string displayName);
+    // Reads up to and including the header: `out` gets its column names and no rows.
+    IoError readHeader(PointSet& out);
+    // Resets `chunk` to the header's columns (dropping any added since, clearing float32) and
+    // fills it with up to `maxRows` rows; it has no rows at the end of the input.
+    IoError readRows(PointSet& chunk, size_t maxRows);
+
+private:
+    std::istream& mIn;
+    std::string mName;
+    std::string mLine;
+    std::vector<std::string> mNames;
+    int mLineNo = 0;
+    int mHeaderLine = 0;
+};
+
 // Writers. Ply writes binary little-endian, PlyAscii ascii — every column as a `float`
 // property (what Houdini and Blender expect), plus a face element when there are faces.
 // Npy writes the columns listed in `npyColumns` (empty: all) as a little-endian float32 array
@@ -60,6 +80,9 @@ IoError readPointsObj(const std::string& path, PointSet& out);
 // (NaN and infinities as null). Obj writes `v x y z` and `f` lines (other columns dropped).
 IoError writePoints(std::ostream& out, const PointSet& points, PointFormat format,
                     const std::vector<int>& npyColumns = {});
+// The CSV writer's rows, with the header line first when `header`: writing the header with
+// the first chunk of rows and the rest without gives the bytes of one writePoints call.
+IoError writePointsCsv(std::ostream& out, const PointSet& points, bool header);
 // Write to a temporary file in the same folder, then rename over `path`: never half-written.
 IoError writePointsFile(const std::string& path, const PointSet& points, PointFormat format,
                         const std::vector<int>& npyColumns = {});

@@ -163,6 +163,54 @@ TEST_CASE("CSV round trip keeps every double exactly", "[pointset][csv]") {
     CHECK(write(sample(), PointFormat::Csv).substr(0, 18) == "x,y,z,u\n0,0.25,1,7");
 }
 
+TEST_CASE("CSV in chunks: the rows, errors and output of the whole-file path", "[pointset][csv]") {
+    // 10 rows with a comment and a blank line among them, read 3 rows at a time.
+    std::string text = "# points\nx,y,z\n";
+    for (int i = 0; i < 10; ++i) {
+        text += std::to_string(i) + ",0.5," + std::to_string(-i) + "\n";
+        if (i == 4) text += "\n# middle\n";
+    }
+    PointSet whole;
+    {
+        std::istringstream in(text);
+        REQUIRE_FALSE(readPointsCsv(in, "p.csv", whole));
+    }
+    std::istringstream in(text);
+    CsvPointReader reader(in, "p.csv");
+    PointSet header, chunk;
+    REQUIRE_FALSE(reader.readHeader(header));
+    CHECK(header.names == std::vector<std::string>{"x", "y", "z"});
+    CHECK(header.size() == 0);
+    std::ostringstream streamed;
+    std::vector<size_t> sizes;
+    for (bool first = true;; first = false) {
+        REQUIRE_FALSE(reader.readRows(chunk, 3));
+        if (chunk.size() == 0) break;
+        sizes.push_back(chunk.size());
+        CHECK(chunk.columns[0][0] == static_cast<double>(3 * (sizes.size() - 1)));
+        chunk.addColumn("extra"); // dropped again by the next readRows
+        chunk.float32.assign(chunk.names.size(), true);
+        REQUIRE_FALSE(writePointsCsv(streamed, chunk, first));
+    }
+    CHECK(sizes == std::vector<size_t>{3, 3, 3, 1});
+    PointSet expected = whole;
+    expected.addColumn("extra");
+    expected.float32.assign(expected.names.size(), true);
+    std::ostringstream once;
+    REQUIRE_FALSE(writePoints(once, expected, PointFormat::Csv));
+    CHECK(streamed.str() == once.str());
+
+    // A bad row in a later chunk is reported at its line of the whole file.
+    std::istringstream bad("x,y,z\n1,2,3\n4,5,6\n7,8,9\n1,oops,3\n");
+    CsvPointReader badReader(bad, "b.csv");
+    REQUIRE_FALSE(badReader.readHeader(header));
+    REQUIRE_FALSE(badReader.readRows(chunk, 2));
+    CHECK(chunk.size() == 2);
+    IoError e = badReader.readRows(chunk, 2);
+    REQUIRE(e);
+    CHECK(e.render() == "b.csv:5:3: error: expected a number, found 'oops'");
+}
+
 TEST_CASE("float32 columns print as the shortest float", "[pointset]") {
     PointSet ps;
     ps.names = {"a", "b"};

@@ -136,6 +136,7 @@ private:
     std::set<std::pair<uint32_t, std::string>> mReported;
     Value mMask; // lanes on which side effects may run (no reg: all)
     bool mTooLarge = false;
+    size_t mInlinedCalls = 0;
 };
 
 // ------------------------------------------------------------------------------------------
@@ -224,6 +225,9 @@ Value Compiler::emit(Instr in, Type result, bool pure) {
         }
     }
     if (!pure) result.lifetime = Lifetime::Varying;
+    // Not folded (no folder, or it declined): the value is computed at run time, once per call,
+    // so it is uniform; a Constant register must hold its value in Bytecode::constants.
+    else if (result.lifetime == Lifetime::Constant) result.lifetime = Lifetime::Uniform;
     in.dst = newReg(result);
     in.width = result.width;
     mBc.code.push_back(in);
@@ -712,6 +716,16 @@ Value Compiler::callDef(const Expr* e, const FunctionDef& def, std::vector<Value
     if (mRecursive.count(&def)) return {}; // reported once by checkRecursion
     if (mInlineStack.size() >= mOpt.maxInlineDepth) {
         error(e->span, "function calls nested too deeply (limit " + std::to_string(mOpt.maxInlineDepth) + ")");
+        return {};
+    }
+    // Reported once, at the outermost call: expanding would take exponential time and memory.
+    if (++mInlinedCalls > mOpt.maxInlinedCalls) {
+        if (mInlinedCalls == mOpt.maxInlinedCalls + 1) {
+            const Span at = mCallSites.empty() ? e->span : mCallSites.front();
+            mSink.error(at, "too many def calls to inline (more than " + std::to_string(mOpt.maxInlinedCalls) +
+                                "): every call copies the def's body, so defs that call defs multiply; "
+                                "compute a value once into a variable and reuse it");
+        }
         return {};
     }
     Env env;

@@ -39,6 +39,8 @@ struct CompileOptions {
     bool allowStringResult = true;
     size_t maxInstructions = 1'000'000;
     uint32_t maxInlineDepth = 64;
+    // def calls expanded in all (each inlines the body: a def calling another twice doubles).
+    size_t maxInlinedCalls = 100'000;
 };
 
 // Null when there were errors (all of them are in `sink`).

@@ -4,6 +4,7 @@
 #include "runtime/builtins.h"
 #include "runtime/builtins_detail.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -22,6 +23,8 @@ struct FormatPiece {
 
 constexpr std::string_view kIntConvs = "diouxXc";
 constexpr std::string_view kFloatConvs = "eEfFgGaA";
+
+constexpr size_t kMaxFormatWidth = 1000;
 
 bool isIntConv(char c) { return kIntConvs.find(c) != std::string_view::npos; }
 bool isFloatConv(char c) { return kFloatConvs.find(c) != std::string_view::npos; }
@@ -54,13 +57,30 @@ bool parseFormat(std::string_view fmt, std::vector<FormatPiece>& out, std::strin
         size_t j = i + 1;
         std::string spec = "%";
         while (j < fmt.size() && std::string_view("-+ #0").find(fmt[j]) != std::string_view::npos) spec += fmt[j++];
-        while (j < fmt.size() && fmt[j] >= '0' && fmt[j] <= '9') spec += fmt[j++];
+        size_t widest = 0; // the larger of width and precision
+        for (size_t w = 0; j < fmt.size() && fmt[j] >= '0' && fmt[j] <= '9'; ++j) {
+            spec += fmt[j];
+            widest = w = std::min<size_t>(w * 10 + static_cast<size_t>(fmt[j] - '0'), 1u << 30);
+        }
         if (j < fmt.size() && fmt[j] == '.') {
             spec += fmt[j++];
-            while (j < fmt.size() && fmt[j] >= '0' && fmt[j] <= '9') spec += fmt[j++];
+            for (size_t w = 0; j < fmt.size() && fmt[j] >= '0' && fmt[j] <= '9'; ++j) {
+                spec += fmt[j];
+                w = std::min<size_t>(w * 10 + static_cast<size_t>(fmt[j] - '0'), 1u << 30);
+                widest = std::max(widest, w);
+            }
         }
         while (j < fmt.size() && std::string_view("hlLqjzt").find(fmt[j]) != std::string_view::npos) ++j;
         const char conv = j < fmt.size() ? fmt[j] : '\0';
+        // Width and precision are capped: "%999999999d" would make a 1 GB string per point.
+        if (widest > kMaxFormatWidth) {
+            if (error)
+                *error = "format width or precision too large in '" + std::string(fmt.substr(i, j + 1 - i)) +
+                         "' (at most " + std::to_string(kMaxFormatWidth) + ")";
+            lit += fmt.substr(i);
+            flushText();
+            return false;
+        }
         if (conv == '\0' || !(isIntConv(conv) || isFloatConv(conv) || conv == 's' || conv == 'v')) {
             if (error) {
                 *error = conv == '\0' ? "incomplete format specifier '" + std::string(fmt.substr(i)) + "'"

@@ -56,7 +56,8 @@ inline float expLane(float x) {
     const float log2e = 1.44269504088896341f;
     const float c1 = 0.693359375f, c2 = -2.12194440e-4f;
     // Clamp into the range the reconstruction handles; results outside are fixed up below.
-    const float xc = x > 88.7228f ? 88.7228f : (x < -103.9721f ? -103.9721f : x);
+    // NaN clamps too (to the low end), so the int conversion below is always defined.
+    const float xc = x > 88.7228f ? 88.7228f : (x >= -103.9721f ? x : -103.9721f);
     const float t = xc * log2e + (xc >= 0.0f ? 0.5f : -0.5f);
     const int32_t n = static_cast<int32_t>(t); // round to nearest
     const float fn = static_cast<float>(n);

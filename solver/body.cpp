@@ -301,6 +301,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         mDv = mDvGuess * (h / mHGuess);
     else
         mDv.setZero(3 * n);
+    mSolver.setPreconditioner(mOptions.preconditioner);
     ls = mSolver.solve(mA, mConstraints, mB, mDv, mOptions.linearSolver, mOptions.cgTolerance,
                        mOptions.cgMaxIterations);
     }

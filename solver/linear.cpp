@@ -208,7 +208,9 @@ SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, co
     VecX y = dv;
     c.apply(y.data());
     SolveStatus st = kind == LinearSolverKind::Direct ? solveDirect(A, c, rhs, y)
-                                                      : solvePcg(A, c, rhs, y, tolerance, maxIterations);
+                     : mPreconditioner == Preconditioner::Multigrid
+                         ? solvePcgMultigrid(A, c, rhs, y, tolerance, maxIterations)
+                         : solvePcg(A, c, rhs, y, tolerance, maxIterations);
     c.apply(y.data());
     dv = y + z;
     if (!dv.allFinite()) {
@@ -318,6 +320,86 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
         ++it;
         rNorm = std::sqrt(rr);
         if (rNorm <= target || !std::isfinite(rNorm)) break;
+        const double beta = rzNew / rz;
+        rz = rzNew;
+        parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
+            for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
+        });
+    }
+    st.iterations = it;
+    st.residual = rNorm / rhsNorm;
+    st.converged = rNorm <= target;
+    if (!std::isfinite(rNorm)) st.failed = true;
+    return st;
+}
+
+// PCG on Â (its BSR copy in the multigrid's level 0) with one symmetric V-cycle as the
+// preconditioner; reductions in fixed chunks as above.
+SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
+                                              VecX& y, double tolerance, int maxIterations) {
+    SolveStatus st;
+    const size_t n3 = 3 * static_cast<size_t>(A.size());
+    const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
+    if (!std::isfinite(rhsNorm)) {
+        st.failed = true;
+        return st;
+    }
+    if (rhsNorm == 0.0) {
+        y.setZero();
+        st.converged = true;
+        return st;
+    }
+    if (!mMultigrid.refresh(A, c, mConstrained)) {
+        st.failed = true;
+        return st;
+    }
+    mR.resize(n3);
+    mZ.resize(n3);
+    mP.resize(n3);
+    mQ.resize(n3);
+    mMultigrid.multiply(y.data(), mQ.data());
+    mR = rhs - mQ;
+    double rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+    const double target = tolerance * rhsNorm;
+    if (rNorm <= target) {
+        st.converged = true;
+        st.residual = rNorm / rhsNorm;
+        return st;
+    }
+    mMultigrid.apply(mR.data(), mZ.data());
+    mP = mZ;
+    double rz = deterministicDot(mR.data(), mZ.data(), n3);
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    mPartial.assign(chunks, 0.0);
+    int it = 0;
+    while (it < maxIterations) {
+        mMultigrid.multiply(mP.data(), mQ.data());
+        const double pq = deterministicDot(mP.data(), mQ.data(), n3);
+        if (!(pq > 0.0) || !std::isfinite(pq)) {
+            st.failed = !std::isfinite(pq);
+            break;
+        }
+        const double alpha = rz / pq;
+        // y += α p; r −= α q; partial sums of r·r.
+        parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+            for (size_t ch = c0; ch < c1; ++ch) {
+                const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
+                double rr = 0.0;
+                for (size_t k = b; k < e; ++k) {
+                    y[k] += alpha * mP[k];
+                    mR[k] -= alpha * mQ[k];
+                    rr += mR[k] * mR[k];
+                }
+                mPartial[ch] = rr;
+            }
+        });
+        double rr = 0.0;
+        for (size_t ch = 0; ch < chunks; ++ch) rr += mPartial[ch];
+        ++it;
+        rNorm = std::sqrt(rr);
+        if (rNorm <= target || !std::isfinite(rNorm)) break;
+        mMultigrid.apply(mR.data(), mZ.data());
+        const double rzNew = deterministicDot(mR.data(), mZ.data(), n3);
         const double beta = rzNew / rz;
         rz = rzNew;
         parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {

@@ -1,9 +1,11 @@
 // The implicit step's linear algebra: a symmetric 3×3-block sparse matrix stored as an Eigen
 // row-major SparseMatrix with a fixed pattern, constraint filters (Baraff–Witkin), and two
-// solvers of the filtered system — preconditioned conjugate gradient (3×3 block Jacobi) and a
-// sparse LDLᵀ — both returning a status, never throwing.
+// solvers of the filtered system — preconditioned conjugate gradient (3×3 block Jacobi, or
+// aggregation multigrid from multigrid.h) and a sparse LDLᵀ — both returning a status, never
+// throwing.
 #pragma once
 
+#include "solver/multigrid.h"
 #include "solver/types.h"
 
 #include <Eigen/SparseCholesky>
@@ -49,6 +51,11 @@ public:
     // y = A x (3n vectors), parallel over rows, deterministic.
     void multiply(const double* x, double* y) const;
 
+    // The block pattern: block row i holds columns blockCols()[blockRowStart()[i] .. [i+1]),
+    // sorted; slot k is the k-th entry of blockCols().
+    const std::vector<int>& blockRowStart() const { return mBlockRowStart; }
+    const std::vector<int>& blockCols() const { return mBlockCols; }
+
     const Eigen::SparseMatrix<double, Eigen::RowMajor>& matrix() const { return mA; }
     Eigen::SparseMatrix<double, Eigen::RowMajor>& matrix() { return mA; }
 
@@ -93,15 +100,24 @@ enum class LinearSolverKind { Pcg, Direct };
 // Baraff–Witkin's modified PCG. `dv` holds the initial guess on entry (warm start).
 class FilteredSolver {
 public:
+    // The PCG preconditioner (block Jacobi by default; see multigrid.h).
+    void setPreconditioner(Preconditioner p) { mPreconditioner = p; }
+    Preconditioner preconditioner() const { return mPreconditioner; }
+    BlockMultigrid& multigrid() { return mMultigrid; }
+
     SolveStatus solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
                       LinearSolverKind kind, double tolerance, int maxIterations);
 
 private:
     SolveStatus solvePcg(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
                          double tolerance, int maxIterations);
+    SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
+                                  double tolerance, int maxIterations);
     SolveStatus solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y);
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
+    Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
+    BlockMultigrid mMultigrid;
     VecX mTmp, mTmp2, mR, mZ, mP, mQ;
     std::vector<double> mPartial;
     std::vector<int> mConstrained; // vertices with S ≠ I

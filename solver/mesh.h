@@ -32,7 +32,8 @@ TriMesh makeGrid(double width, double height, int nx, int ny, const Vec3& origin
                  const Vec3& axisU = Vec3::UnitX(), const Vec3& axisV = Vec3::UnitY());
 
 // Reads an OBJ or PLY mesh (by extension). Polygons with more than three corners are fan-split;
-// faces with out-of-range or repeated indices are dropped (counted in `dropped`). On failure
+// faces with repeated indices are dropped (counted in `dropped`); an index out of range is an
+// error of the point reader. On failure
 // returns false with `error` = "file:line:col: message" style text.
 bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dropped = nullptr);
 

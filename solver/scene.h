@@ -93,9 +93,12 @@ bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::Sc
 
 // Loads meshes and strands, evaluates painted maps and pins, and makes the bodies. Problems
 // (a missing mesh, an unknown map, an expression error) come back as errors at the place in
-// the scene that named them; `warnings` gets notes such as degenerate-triangle counts.
+// the scene that named them; `warnings` gets notes such as degenerate-triangle counts. Files
+// named in painted-map expressions resolve like the wind's: inside the scene's folder or one of
+// `allowPaths` (--allow-path).
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
-                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings);
+                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings,
+                 const std::vector<std::string>& allowPaths = {});
 
 // World settings of a scene (threads: 0 for all hardware threads).
 WorldSettings worldSettings(const SimScene& scene, int threads);

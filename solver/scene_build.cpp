@@ -39,7 +39,7 @@ Vec3 axisOf(char c) { return c == 'x' ? Vec3::UnitX() : c == 'y' ? Vec3::UnitY()
 bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::string& what,
                  const std::vector<double>& positions, const std::vector<double>& u, const std::vector<double>& v,
                  const std::map<std::string, std::vector<double>>& attributes, std::vector<double>& values,
-                 std::vector<fields::SceneError>& errors) {
+                 std::vector<fields::SceneError>& errors, const std::vector<std::string>& allowPaths) {
     values.clear();
     const size_t n = positions.size() / 3;
     if (!spec.map.empty()) {
@@ -77,7 +77,12 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     settings.variables.push_back({"u", lang::Type::fp(1, lang::Lifetime::Varying)});
     settings.variables.push_back({"v", lang::Type::fp(1, lang::Lifetime::Varying)});
     settings.wantWidth = 1;
-    settings.functions = fields::fieldFunctions();
+    // File names (sdf("body.obj", ...)) resolve against the map's file (the scene for inline
+    // text) and stay inside the scene's folder, as in the wind's expressions.
+    fields::FileAccess files =
+        fields::fileAccessFor(spec.exprPath.empty() ? scene.wind.path : spec.exprPath, allowPaths);
+    files.rootDir = scene.wind.baseDir.empty() ? "." : scene.wind.baseDir;
+    settings.functions = fields::fieldFunctions(files);
     lang::DiagnosticSink sink;
     std::shared_ptr<const runtime::Program> program = runtime::Program::compile(source, settings, sink);
     if (!program) {
@@ -131,7 +136,8 @@ WorldSettings worldSettings(const SimScene& scene, int threads) {
 }
 
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
-                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings) {
+                 std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings,
+                 const std::vector<std::string>& allowPaths) {
     const size_t before = errors.size();
     for (const ClothSpec& spec : scene.cloths) {
         const std::string what = "[[cloth]] '" + spec.name + "'";
@@ -163,8 +169,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         ClothMaterial mat = spec.material;
         mat.lift.value = spec.lift.value;
         mat.drag.value = spec.drag.value;
-        bool ok = evaluateMap(scene, spec.lift, what + " lift", mesh.positions, u, v, mesh.attributes, mat.lift.map, errors);
-        ok = evaluateMap(scene, spec.drag, what + " drag", mesh.positions, u, v, mesh.attributes, mat.drag.map, errors) && ok;
+        bool ok = evaluateMap(scene, spec.lift, what + " lift", mesh.positions, u, v, mesh.attributes, mat.lift.map, errors, allowPaths);
+        ok = evaluateMap(scene, spec.drag, what + " drag", mesh.positions, u, v, mesh.attributes, mat.drag.map, errors, allowPaths) && ok;
         if (!ok) continue;
         auto cloth = std::make_unique<Cloth>(spec.name, mesh, mat);
         cloth->options() = spec.step;
@@ -251,9 +257,9 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         mat.dragNormal.value = spec.dragNormal.value;
         mat.dragTangent.value = spec.dragTangent.value;
         bool ok = evaluateMap(scene, spec.dragNormal, what + " drag_normal", strands.positions, u, v, strands.attributes,
-                              mat.dragNormal.map, errors);
+                              mat.dragNormal.map, errors, allowPaths);
         ok = evaluateMap(scene, spec.dragTangent, what + " drag_tangent", strands.positions, u, v, strands.attributes,
-                         mat.dragTangent.map, errors) && ok;
+                         mat.dragTangent.map, errors, allowPaths) && ok;
         if (!ok) continue;
         auto hair = std::make_unique<Hair>(spec.name, strands, mat);
         hair->options() = spec.step;

@@ -21,6 +21,9 @@ namespace gale::solver {
 namespace {
 
 constexpr std::string_view kSetPrefix = "--set ";
+// Generated cloth and hair grids: at most this many vertices (a million already takes the
+// implicit solver minutes a frame and gigabytes).
+constexpr long long kMaxGridVertices = 1LL << 20;
 
 std::string trim(std::string_view s) {
     const size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
@@ -64,12 +67,12 @@ const char* typeName(const toml::node& n) {
 
 const std::vector<std::string> kClothKeys = {
     "name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift", "drag",
-    "aero_model", "aero_jacobian", "pins", "linear_solver", "cg_tolerance", "cg_max_iterations",
-    "newton_iterations", "output"};
+    "aero_model", "aero_jacobian", "pins", "linear_solver", "preconditioner", "cg_tolerance",
+    "cg_max_iterations", "newton_iterations", "output"};
 const std::vector<std::string> kHairKeys = {
     "name", "strands", "grid", "radius", "density", "stretch", "bend", "damping", "drag_normal",
-    "drag_tangent", "root_pinned", "pins", "linear_solver", "cg_tolerance", "cg_max_iterations",
-    "newton_iterations", "output"};
+    "drag_tangent", "root_pinned", "pins", "linear_solver", "preconditioner", "cg_tolerance",
+    "cg_max_iterations", "newton_iterations", "output"};
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
@@ -544,6 +547,11 @@ void Loader::stepOptions(const toml::table& t, const std::string& what, StepOpti
         if (choice(*n, "linear_solver", {"pcg", "direct"}, v))
             s.linearSolver = v == "direct" ? LinearSolverKind::Direct : LinearSolverKind::Pcg;
     }
+    if (const toml::node* n = t.get("preconditioner")) {
+        std::string v;
+        if (choice(*n, "preconditioner", {"multigrid", "jacobi"}, v))
+            s.preconditioner = v == "jacobi" ? Preconditioner::BlockJacobi : Preconditioner::Multigrid;
+    }
     if (const toml::node* n = t.get("cg_tolerance")) number(*n, what + ": cg_tolerance", s.cgTolerance, 0.0, true);
     if (const toml::node* n = t.get("cg_max_iterations")) {
         long long v = 0;
@@ -588,10 +596,19 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
             if (!a || a->size() != 2) {
                 error(*r, what + ": grid res must be [nx, ny] (vertices along each side)");
             } else {
+                long long total = 1, widest = 0;
                 for (int k = 0; k < 2; ++k) {
                     long long x = 0;
                     if (integer(*a->get(k), what + ": grid res", x, 2)) c.gridRes[k] = static_cast<int>(std::min(x, 4096LL));
+                    total *= std::min(x, 1LL << 30);
+                    widest = std::max(widest, x);
                 }
+                // Limits, not a silent clamp: a larger grid would take hours and tens of GB.
+                if (widest > 4096)
+                    error(*r, what + ": grid res must be at most 4096 vertices along each side");
+                else if (total > kMaxGridVertices)
+                    error(*r, what + ": grid res gives " + std::to_string(total) + " vertices, more than the limit of " +
+                                  std::to_string(kMaxGridVertices) + " (1024 x 1024)");
             }
         }
         if (const toml::node* o = g->get("origin")) vec3(*o, what + ": grid origin", c.gridOrigin);
@@ -658,6 +675,10 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
                 for (int k = 0; k < 2; ++k) {
                     long long x = 0;
                     if (integer(*a->get(k), what + ": grid count", x, 1)) h.gridCount[k] = static_cast<int>(std::min(x, 4096LL));
+                    if (x > 4096) {
+                        error(*r, what + ": grid count must be at most 4096 strands along each side");
+                        break;
+                    }
                 }
             }
         }
@@ -665,7 +686,14 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
         if (const toml::node* n = g->get("segments")) {
             long long x = 0;
             if (integer(*n, what + ": grid segments", x, 1)) h.segments = static_cast<int>(std::min(x, 100000LL));
+            if (x > 100000) error(*n, what + ": grid segments must be at most 100000");
         }
+        // A limit, not a silent clamp: strands x (segments + 1) vertices.
+        const long long vertices = static_cast<long long>(h.gridCount[0]) * h.gridCount[1] * (h.segments + 1LL);
+        if (vertices > kMaxGridVertices)
+            error(*grid, what + ": the strand grid would have " + std::to_string(vertices) +
+                             " vertices, more than the limit of " + std::to_string(kMaxGridVertices) +
+                             ": use fewer strands or segments");
         if (const toml::node* o = g->get("origin")) vec3(*o, what + ": grid origin", h.origin);
         if (const toml::node* d = g->get("direction"))
             if (vec3(*d, what + ": grid direction", h.direction) && h.direction.norm() == 0.0)

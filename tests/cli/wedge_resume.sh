@@ -32,7 +32,12 @@ for _ in $(seq 1 600); do
     [ -f w/v000_lift=0.1/DONE ] && break
     sleep 0.05
 done
-sleep 0.4 # the second variant is under way: some of its frames are written
+# The second variant is under way: wait until some of its frames are written (polling, not a
+# fixed delay, so a loaded machine cannot kill it before it saved anything to resume from).
+for _ in $(seq 1 600); do
+    compgen -G 'w/v001_*/c.0004.obj' > /dev/null && break
+    sleep 0.05
+done
 kill -TERM "$pid"
 wait "$pid"
 rc=$?

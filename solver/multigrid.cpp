@@ -1,0 +1,412 @@
+// Aggregation AMG preconditioner for the filtered cloth system and its BSR matrix (see
+// multigrid.h). References: Vaněk, Mandel, Brezina, "Algebraic multigrid by smoothed
+// aggregation", Computing 56 (1996); Tamstorf, Jones, McCormick, "Smoothed aggregation
+// multigrid for cloth simulation", SIGGRAPH Asia 2015.
+#include "solver/multigrid.h"
+
+#include "solver/linear.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+
+namespace gale::solver {
+
+namespace {
+
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+using BlockMap = Eigen::Map<RowMat3>;
+using ConstBlockMap = Eigen::Map<const RowMat3>;
+
+// The inverse of a 3×3 diagonal block; a scaled identity when it is singular.
+void invertBlock(const double* b, double* out) {
+    const Mat3 d = ConstBlockMap(b);
+    Mat3 inv;
+    bool ok = false;
+    double det = 0.0;
+    d.computeInverseAndDetWithCheck(inv, det, ok, 0.0);
+    if (!ok || !inv.allFinite()) {
+        const double dd = std::max(d.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+        inv = Mat3::Identity() / dd;
+    }
+    BlockMap m(out);
+    m = inv;
+}
+
+Mat3 filterOf(uint8_t kind, const double* normal) {
+    if (kind == 1) return Mat3::Zero();
+    if (kind == 2) {
+        const Vec3 n(normal[0], normal[1], normal[2]);
+        return Mat3::Identity() - n * n.transpose();
+    }
+    return Mat3::Identity();
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BsrMatrix
+
+void BsrMatrix::multiply(const double* x, double* y) const {
+    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+            for (int k = start[i]; k < start[i + 1]; ++k) {
+                const double* b = val.data() + 9 * static_cast<size_t>(k);
+                const double* xj = x + 3 * static_cast<size_t>(cols[k]);
+                const double a = xj[0], c = xj[1], d = xj[2];
+                y0 += b[0] * a + b[1] * c + b[2] * d;
+                y1 += b[3] * a + b[4] * c + b[5] * d;
+                y2 += b[6] * a + b[7] * c + b[8] * d;
+            }
+            y[3 * i] = y0;
+            y[3 * i + 1] = y1;
+            y[3 * i + 2] = y2;
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: set-up
+
+void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
+    mLevels.assign(1, Level());
+    BsrMatrix& a = mLevels[0].a;
+    a.n = A.size();
+    a.start = A.blockRowStart();
+    a.cols = A.blockCols();
+    a.val.assign(9 * a.cols.size(), 0.0);
+    a.diag.resize(a.n);
+    a.mirror.resize(a.cols.size());
+    for (int i = 0; i < a.n; ++i) {
+        a.diag[i] = A.diagonalSlot(i);
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) a.mirror[k] = A.slot(a.cols[k], i);
+    }
+    mPatternRows = A.size();
+    mPatternSlots = A.slotCount();
+}
+
+// Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
+// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit);
+// builds the pattern of `coarse` and the slot map.
+void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
+    const BsrMatrix& a = fine.a;
+    const int n = a.n;
+    std::vector<int> agg(n, -1), size;
+    // 1. Roots: a vertex whose neighbours are all unaggregated starts an aggregate with them.
+    for (int i = 0; i < n; ++i) {
+        if (agg[i] >= 0) continue;
+        bool free = true;
+        for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
+            if (agg[a.cols[k]] >= 0) free = false;
+        if (!free) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) agg[a.cols[k]] = static_cast<int>(size.size());
+        size.push_back(a.start[i + 1] - a.start[i]);
+    }
+    // 2. The rest join the smallest neighbouring aggregate (ties: the lower index), decided
+    // from the phase-1 labels only, so the order of the rows does not matter.
+    std::vector<int> joined = agg;
+    for (int i = 0; i < n; ++i) {
+        if (agg[i] >= 0) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+            const int J = agg[a.cols[k]];
+            if (J >= 0 && (joined[i] < 0 || size[J] < size[joined[i]] || (size[J] == size[joined[i]] && J < joined[i])))
+                joined[i] = J;
+        }
+    }
+    // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
+    int count = static_cast<int>(size.size());
+    for (int i = 0; i < n; ++i) {
+        if (joined[i] >= 0) continue;
+        joined[i] = count;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            if (joined[a.cols[k]] < 0) joined[a.cols[k]] = count;
+        ++count;
+    }
+    fine.agg = std::move(joined);
+    fine.memberStart.assign(count + 1, 0);
+    for (int i = 0; i < n; ++i) ++fine.memberStart[fine.agg[i] + 1];
+    for (int I = 0; I < count; ++I) fine.memberStart[I + 1] += fine.memberStart[I];
+    fine.members.resize(n);
+    {
+        std::vector<int> fill(fine.memberStart.begin(), fine.memberStart.end() - 1);
+        for (int i = 0; i < n; ++i) fine.members[fill[fine.agg[i]]++] = i;
+    }
+    // Coarse pattern: (agg i, agg j) for every fine block (i, j).
+    std::vector<std::vector<int>> rows(count);
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) rows[fine.agg[i]].push_back(fine.agg[a.cols[k]]);
+    BsrMatrix& c = coarse.a;
+    c.n = count;
+    c.start.assign(count + 1, 0);
+    c.cols.clear();
+    for (int I = 0; I < count; ++I) {
+        std::sort(rows[I].begin(), rows[I].end());
+        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
+        c.cols.insert(c.cols.end(), rows[I].begin(), rows[I].end());
+        c.start[I + 1] = static_cast<int>(c.cols.size());
+    }
+    auto slotOf = [&](int I, int J) {
+        auto b = c.cols.begin() + c.start[I], e = c.cols.begin() + c.start[I + 1];
+        return static_cast<int>(std::lower_bound(b, e, J) - c.cols.begin());
+    };
+    c.diag.resize(count);
+    c.mirror.resize(c.cols.size());
+    for (int I = 0; I < count; ++I) {
+        c.diag[I] = slotOf(I, I);
+        for (int k = c.start[I]; k < c.start[I + 1]; ++k) c.mirror[k] = slotOf(c.cols[k], I);
+    }
+    c.val.assign(9 * c.cols.size(), 0.0);
+    fine.coarseSlot.resize(a.cols.size());
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            fine.coarseSlot[k] = slotOf(fine.agg[i], fine.agg[a.cols[k]]);
+}
+
+// A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
+// I − S part and aggregates with a direction no member can move in get an identity there.
+void BlockMultigrid::coarsen(int l) {
+    Level& f = mLevels[l];
+    BsrMatrix& c = mLevels[l + 1].a;
+    std::fill(c.val.begin(), c.val.end(), 0.0);
+    const BsrMatrix& a = f.a;
+    for (int i = 0; i < a.n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+            double* dst = c.val.data() + 9 * static_cast<size_t>(f.coarseSlot[k]);
+            const double* src = a.val.data() + 9 * static_cast<size_t>(k);
+            for (int q = 0; q < 9; ++q) dst[q] += src[q];
+        }
+    if (l != 0 || mKind.empty()) return;
+    for (int i = 0; i < a.n; ++i) {
+        if (!mKind[i]) continue;
+        // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
+        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.agg[i]])) -=
+            Mat3::Identity() - filterOf(mKind[i], mNormal.data() + 3 * i);
+    }
+    for (int I = 0; I < c.n; ++I) {
+        bool any = false;
+        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) any = any || mKind[f.members[m]];
+        if (!any) continue;
+        Mat3 B = Mat3::Zero();
+        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) {
+            const int i = f.members[m];
+            B += filterOf(mKind[i], mNormal.data() + 3 * i);
+        }
+        Eigen::SelfAdjointEigenSolver<Mat3> es(B);
+        BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
+        const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
+        for (int e = 0; e < 3; ++e)
+            if (es.eigenvalues()[e] < 1e-8) {
+                const Vec3 v = es.eigenvectors().col(e);
+                d += scale * v * v.transpose();
+            }
+    }
+}
+
+bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained) {
+    const bool fresh = mLevels.empty() || mPatternRows != A.size() || mPatternSlots != A.slotCount();
+    if (fresh) buildHierarchy(A);
+    // Level 0: Â = S A S + I − S.
+    BsrMatrix& a = mLevels[0].a;
+    const int n = a.n;
+    bool finite = true;
+    for (int k = 0; k < a.blocks(); ++k) {
+        const Mat3 b = A.block(k);
+        BlockMap(a.val.data() + 9 * static_cast<size_t>(k)) = b;
+    }
+    for (double v : a.val)
+        if (!std::isfinite(v)) finite = false;
+    if (!finite) return false;
+    mKind.clear();
+    if (!constrained.empty()) {
+        mKind.assign(n, 0);
+        mNormal.assign(3 * static_cast<size_t>(n), 0.0);
+        for (int i : constrained) {
+            mKind[i] = cons.kind[i];
+            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * i + q];
+        }
+        for (int i : constrained) {
+            const Mat3 S = filterOf(mKind[i], mNormal.data() + 3 * i);
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
+                row = (S * row).eval();
+                BlockMap col(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]));
+                col = (col * S).eval();
+            }
+            BlockMap(a.val.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+        }
+    }
+    // Coarse levels: aggregate on first sight of the pattern, then sum.
+    for (int l = 0;; ++l) {
+        if (fresh) {
+            if (mLevels[l].a.n <= mSettings.coarsest) break;
+            Level next;
+            aggregate(mLevels[l], next);
+            if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
+                mLevels[l].agg.clear();
+                break;
+            }
+            mLevels.push_back(std::move(next));
+        } else if (l + 1 >= static_cast<int>(mLevels.size())) {
+            break;
+        }
+        coarsen(l);
+    }
+    for (Level& L : mLevels) {
+        L.lowVal.resize(L.a.val.size());
+        for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        L.dinv.resize(9 * static_cast<size_t>(L.a.n));
+        // The inverse of the single-precision diagonal, so that every sweep reads one matrix
+        // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
+        for (int i = 0; i < L.a.n; ++i) {
+            double d[9];
+            for (int q = 0; q < 9; ++q) d[q] = L.lowVal[9 * static_cast<size_t>(L.a.diag[i]) + q];
+            invertBlock(d, L.dinv.data() + 9 * static_cast<size_t>(i));
+        }
+        const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+        L.r.resize(n3);
+        L.x.resize(n3);
+        L.t.resize(n3);
+    }
+    // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
+    // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
+    const BsrMatrix& c = mLevels.back().a;
+    mCoarseOk = false;
+    if (c.n > 2 * std::max(mSettings.coarsest, 1)) return true;
+    mCoarseDense.setZero(3 * c.n, 3 * c.n);
+    for (int I = 0; I < c.n; ++I)
+        for (int k = c.start[I]; k < c.start[I + 1]; ++k)
+            mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) = ConstBlockMap(c.val.data() + 9 * static_cast<size_t>(k));
+    mCoarseLlt.compute(mCoarseDense);
+    mCoarseOk = mCoarseLlt.info() == Eigen::Success;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: the V-cycle
+
+void BlockMultigrid::smooth(int l, bool forward, bool fromZero) {
+    Level& L = mLevels[l];
+    const BsrMatrix& a = L.a;
+    const int n = a.n;
+    double* x = L.x.data();
+    const double* r = L.r.data();
+    if (mSettings.gaussSeidel) {
+        // x_i += D_i⁻¹ (r_i − Σ_j A_ij x_j), rows in order (forward) or reverse (backward).
+        // From zero, a forward sweep reads only the rows before i (the rest are still zero).
+        const int* start = a.start.data();
+        const int* cols = a.cols.data();
+        const int* diag = a.diag.data();
+        const float* val = L.lowVal.data();
+        const double* dinv = L.dinv.data();
+        for (int s = 0; s < n; ++s) {
+            const int i = forward ? s : n - 1 - s;
+            double y0 = r[3 * i], y1 = r[3 * i + 1], y2 = r[3 * i + 2];
+            const int end = fromZero && forward ? diag[i] : start[i + 1];
+            for (int k = start[i]; k < end; ++k) {
+                const float* b = val + 9 * static_cast<size_t>(k);
+                const double* xj = x + 3 * static_cast<size_t>(cols[k]);
+                const double p = xj[0], q = xj[1], u = xj[2];
+                y0 -= b[0] * p + b[1] * q + b[2] * u;
+                y1 -= b[3] * p + b[4] * q + b[5] * u;
+                y2 -= b[6] * p + b[7] * q + b[8] * u;
+            }
+            const double* d = dinv + 9 * static_cast<size_t>(i);
+            x[3 * i] += d[0] * y0 + d[1] * y1 + d[2] * y2;
+            x[3 * i + 1] += d[3] * y0 + d[4] * y1 + d[5] * y2;
+            x[3 * i + 2] += d[6] * y0 + d[7] * y1 + d[8] * y2;
+        }
+        return;
+    }
+    // Damped block Jacobi: x += ω D⁻¹ (r − A x).
+    const double w = mSettings.jacobiWeight;
+    if (!fromZero) a.multiply(x, L.t.data());
+    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            double y[3];
+            for (int q = 0; q < 3; ++q) y[q] = r[3 * i + q] - (fromZero ? 0.0 : L.t[3 * i + q]);
+            const double* d = L.dinv.data() + 9 * i;
+            for (int q = 0; q < 3; ++q) {
+                const double v = w * (d[3 * q] * y[0] + d[3 * q + 1] * y[1] + d[3 * q + 2] * y[2]);
+                x[3 * i + q] = fromZero ? v : x[3 * i + q] + v;
+            }
+        }
+    });
+}
+
+void BlockMultigrid::cycle(int l) {
+    Level& L = mLevels[l];
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    if (l + 1 == static_cast<int>(mLevels.size())) {
+        if (mCoarseOk) {
+            Eigen::Map<VecX>(L.x.data(), n3) = mCoarseLlt.solve(Eigen::Map<const VecX>(L.r.data(), n3));
+        } else { // a symmetric pair of sweeps
+            std::fill(L.x.begin(), L.x.end(), 0.0);
+            smooth(l, true, true);
+            smooth(l, false, false);
+        }
+        return;
+    }
+    std::fill(L.x.begin(), L.x.end(), 0.0);
+    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, true, s == 0);
+    // t = r − A x. After one forward Gauss–Seidel sweep from zero, rows up to i already
+    // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j (half a product).
+    const BsrMatrix& a = L.a;
+    if (mSettings.gaussSeidel && mSettings.sweeps == 1) {
+        parallelChunks(static_cast<size_t>(a.n), 512, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) {
+                double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+                for (int k = a.diag[i] + 1; k < a.start[i + 1]; ++k) {
+                    const float* b = L.lowVal.data() + 9 * static_cast<size_t>(k);
+                    const double* xj = L.x.data() + 3 * static_cast<size_t>(a.cols[k]);
+                    y0 -= b[0] * xj[0] + b[1] * xj[1] + b[2] * xj[2];
+                    y1 -= b[3] * xj[0] + b[4] * xj[1] + b[5] * xj[2];
+                    y2 -= b[6] * xj[0] + b[7] * xj[1] + b[8] * xj[2];
+                }
+                L.t[3 * i] = y0, L.t[3 * i + 1] = y1, L.t[3 * i + 2] = y2;
+            }
+        });
+    } else {
+        a.multiply(L.x.data(), L.t.data());
+        for (size_t k = 0; k < n3; ++k) L.t[k] = L.r[k] - L.t[k];
+    }
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i.
+    Level& C = mLevels[l + 1];
+    const bool filtered = l == 0 && !mKind.empty();
+    parallelChunks(static_cast<size_t>(C.a.n), 256, [&](size_t I0, size_t I1) {
+        for (size_t I = I0; I < I1; ++I) {
+            Vec3 s = Vec3::Zero();
+            for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
+                const int i = L.members[m];
+                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
+                if (filtered && mKind[i]) t = filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                s += t;
+            }
+            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
+        }
+    });
+    cycle(l + 1);
+    // x += α S P_tent e.
+    const double alpha = mSettings.coarseWeight;
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const int I = L.agg[i];
+            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
+            if (filtered && mKind[i]) e = filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            for (int q = 0; q < 3; ++q) L.x[3 * i + q] += alpha * e[q];
+        }
+    });
+    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+}
+
+void BlockMultigrid::apply(const double* r, double* z) {
+    Level& L = mLevels[0];
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    std::copy(r, r + n3, L.r.begin());
+    cycle(0);
+    std::copy(L.x.begin(), L.x.end(), z);
+}
+
+} // namespace gale::solver

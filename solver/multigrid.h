@@ -1,0 +1,96 @@
+// An aggregation algebraic-multigrid preconditioner for the filtered 3×3-block cloth system
+// (Tamstorf, Jones, McCormick 2015), applied as one symmetric V-cycle per CG iteration, and the
+// block-CSR (BSR) copy of the filtered matrix Â that the multigrid CG multiplies with.
+#pragma once
+
+#include "solver/types.h"
+
+#include <Eigen/Cholesky>
+
+#include <cstdint>
+#include <vector>
+
+namespace gale::solver {
+
+class BlockMatrix;
+struct Constraints;
+
+// How the filtered system is preconditioned inside conjugate gradient.
+enum class Preconditioner { BlockJacobi, Multigrid };
+
+// A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
+// row-major, column cols[k]; columns sorted, the diagonal present.
+struct BsrMatrix {
+    int n = 0;
+    std::vector<int> start, cols, diag, mirror; // mirror[k]: slot of the transposed block
+    std::vector<double> val;
+
+    int blocks() const { return static_cast<int>(cols.size()); }
+    // y = M x, parallel over rows (deterministic: each row is summed in column order).
+    void multiply(const double* x, double* y) const;
+};
+
+// Plain (unsmoothed) aggregation AMG with a constraint-filtered tentative prolongator:
+//   P₀ = S P_tent,  P_tent(i, I) = I₃ when vertex i is in aggregate I  (translations: the
+// near-null space of the membrane stiffness), so the Galerkin operators
+//   A_{l+1} = P_lᵀ A_l P_l
+// are sums of the fine blocks and the coarse levels never see the constrained directions
+// (Tamstorf et al. 2015, §4). Aggregates (Vaněk, Mandel, Brezina 1996: a root plus its
+// neighbours, then the rest joined to a neighbouring aggregate) are chosen once per matrix
+// pattern, from the pattern alone; every later refresh only re-sums the values.
+// The V-cycle uses damped block-Jacobi smoothing (ν sweeps before and the same after) or a
+// forward/backward block Gauss–Seidel pair, and a dense Cholesky on the coarsest level, so
+// the preconditioner is symmetric positive definite. The smoother reads a single-precision copy
+// of each level's matrix (half the memory traffic; the V-cycle only approximates Â⁻¹ anyway),
+// while conjugate gradient multiplies with Â in double precision.
+class BlockMultigrid {
+public:
+    struct Settings {
+        bool gaussSeidel = true;    // symmetric block Gauss–Seidel, else damped block Jacobi
+        int sweeps = 1;             // smoothing sweeps before and after the coarse correction
+        double jacobiWeight = 0.6;  // ω of damped block Jacobi
+        double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
+        int coarsest = 48;          // stop coarsening at this many block rows
+    };
+
+    Settings& settings() { return mSettings; }
+
+    // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates are built
+    // when the pattern of A is new. Returns false when a value is not finite.
+    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained);
+    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero).
+    void apply(const double* r, double* z);
+    // y = Â x with the level-0 copy.
+    void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
+
+    int levelCount() const { return static_cast<int>(mLevels.size()); }
+    int rows(int level) const { return mLevels[level].a.n; }
+
+private:
+    struct Level {
+        BsrMatrix a;
+        std::vector<float> lowVal;     // a.val in single precision, read by the smoother
+        std::vector<double> dinv;      // 9 per row: inverse diagonal block
+        std::vector<int> agg;          // aggregate (row of the next level) per row
+        std::vector<int> memberStart, members; // rows of each aggregate
+        std::vector<int> coarseSlot;   // slot of the next level's matrix per slot
+        std::vector<double> r, x, t;   // 3n work vectors
+    };
+
+    void buildHierarchy(const BlockMatrix& A);
+    void aggregate(Level& fine, Level& coarse);
+    void coarsen(int l);
+    void smooth(int l, bool forward, bool fromZero);
+    void cycle(int l);
+
+    Settings mSettings;
+    std::vector<Level> mLevels;
+    int mPatternRows = -1, mPatternSlots = -1;
+    std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
+    std::vector<double> mNormal;
+    Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
+    Eigen::MatrixXd mCoarseDense;
+    bool mCoarseOk = false;
+};
+
+} // namespace gale::solver
