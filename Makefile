@@ -84,7 +84,7 @@ test-asan: deps
 	@rm -rf $(ASAN_BUILD)/san-reports && mkdir -p $(ASAN_BUILD)/san-reports
 	cd $(ASAN_BUILD) && \
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:log_path=$(abspath $(ASAN_BUILD))/san-reports/asan \
-	LSAN_OPTIONS=suppressions=$(SAN_SUPP)/lsan.supp \
+	LSAN_OPTIONS=suppressions=$(SAN_SUPP)/lsan.supp:print_suppressions=0 \
 	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:log_path=$(abspath $(ASAN_BUILD))/san-reports/ubsan \
 		ctest --output-on-failure -j $(JOBS) -LE heavy; rc=$$?; \
 	$(call san_check,san-reports); exit $$rc
@@ -100,7 +100,7 @@ test-tsan: deps
 	JOBS=$(JOBS) tests/sanitizers/tbb_tsan.sh $(TSAN_BUILD)/onetbb
 	@rm -rf $(TSAN_BUILD)/san-reports && mkdir -p $(TSAN_BUILD)/san-reports
 	cd $(TSAN_BUILD) && LD_LIBRARY_PATH=$(abspath $(TSAN_BUILD))/onetbb/lib \
-	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:log_path=$(abspath $(TSAN_BUILD))/san-reports/tsan \
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$(SAN_SUPP)/tsan.supp:log_path=$(abspath $(TSAN_BUILD))/san-reports/tsan \
 		ctest --output-on-failure -j $(JOBS) -LE heavy -R '^(runtime|solver)_tests:'; rc=$$?; \
 	$(call san_check,san-reports); exit $$rc
 

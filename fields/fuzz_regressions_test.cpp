@@ -67,3 +67,26 @@ TEST_CASE("OBJ faces must name existing vertices, like PLY faces", "[fuzz][point
         CHECK(back.faces == ps.faces);
     }
 }
+
+// fuzz_readers: CSV columns "a b" and "a_b" were both written to PLY as property "a_b" (a PLY
+// name has no spaces), and the PLY reader rejects a property declared twice. Now the second
+// one is "a_b_2"; control characters in names are replaced too.
+TEST_CASE("PLY property names are made unique and free of spaces and controls", "[fuzz][pointset][ply]") {
+    std::istringstream csv("a b,a_b,c\td\n1,2,3\n");
+    PointSet ps;
+    IoError e = readPointsCsv(csv, "names.csv", ps);
+    INFO(e.render());
+    REQUIRE(!e);
+    REQUIRE(ps.names.size() == 3);
+    for (PointFormat format : {PointFormat::Ply, PointFormat::PlyAscii}) {
+        std::stringstream ply;
+        REQUIRE(!writePoints(ply, ps, format));
+        PointSet back;
+        IoError r = readPointsPly(ply, "names.ply", back);
+        INFO(r.render());
+        REQUIRE(!r);
+        CHECK(back.names == std::vector<std::string>{"a_b", "a_b_2", "c_d"});
+        REQUIRE(back.size() == 1);
+        CHECK(back.columns[2][0] == 3);
+    }
+}

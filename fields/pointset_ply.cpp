@@ -13,6 +13,7 @@
 #include <cstring>
 #include <istream>
 #include <ostream>
+#include <set>
 #include <string_view>
 
 namespace gale::fields {
@@ -446,8 +447,22 @@ std::string plyName(const std::string& s) {
     if (s.empty()) return "unnamed";
     std::string r = s;
     for (char& c : r)
-        if (std::isspace(static_cast<unsigned char>(c))) c = '_';
+        if (static_cast<unsigned char>(c) <= ' ' || c == '\x7f') c = '_'; // spaces, controls, NUL
     return r;
+}
+
+// Property names for the columns: plyName, made unique ("a b" and "a_b" are "a_b", "a_b_2"),
+// since a reader rejects a property declared twice.
+std::vector<std::string> plyNames(const std::vector<std::string>& names) {
+    std::vector<std::string> out;
+    std::set<std::string> used;
+    for (const std::string& s : names) {
+        const std::string base = plyName(s);
+        std::string name = base;
+        for (int k = 2; !used.insert(name).second; ++k) name = base + "_" + std::to_string(k);
+        out.push_back(name);
+    }
+    return out;
 }
 
 void appendLE(std::string& out, const void* p, size_t n) {
@@ -471,7 +486,7 @@ IoError writePly(std::ostream& out, const PointSet& ps, bool binary) {
     buf += binary ? "format binary_little_endian 1.0\n" : "format ascii 1.0\n";
     buf += "comment written by gale\n";
     buf += "element vertex " + std::to_string(n) + "\n";
-    for (const std::string& name : ps.names) buf += "property float " + plyName(name) + "\n";
+    for (const std::string& name : plyNames(ps.names)) buf += "property float " + name + "\n";
     if (!ps.faces.empty()) {
         buf += "element face " + std::to_string(ps.faces.size()) + "\n";
         buf += std::string("property list ") + countType + " int vertex_indices\n";

@@ -38,7 +38,7 @@ struct PinSet {
 struct StepOptions {
     AeroJacobian aeroJacobian = AeroJacobian::Projected;
     LinearSolverKind linearSolver = LinearSolverKind::Pcg;
-    Preconditioner preconditioner = Preconditioner::BlockJacobi; // of PCG (multigrid.h)
+    Preconditioner preconditioner = Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
     double cgTolerance = 1e-3;  // relative residual of the filtered system
     int cgMaxIterations = 2000;
     int newtonIterations = 0;   // extra Newton iterations on the backward-Euler residual

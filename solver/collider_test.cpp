@@ -155,17 +155,28 @@ TEST_CASE("colliders: hair falls onto a capsule and rests on it", "[collider][ha
 }
 
 TEST_CASE("colliders: a keyframed sphere lifts the cloth", "[collider]") {
-    TriMesh mesh = makeGrid(0.6, 0.6, 10, 10, Vec3(-0.3, 0.0, -0.3), Vec3::UnitX(), Vec3::UnitZ());
-    World w(WorldSettings{});
-    w.addBody(std::make_unique<Cloth>("sheet", mesh, stillAirCloth(0.1)));
-    Collider s = sphere(Vec3::Zero(), 0.2);
-    s.a = Param::keyed({0.0, 1.0}, {{0, -0.25, 0}, {0, 0.75, 0}}, gale::fields::KeyInterp::Linear);
-    s.friction = 0.5;
-    w.addCollider(s);
-    for (int f = 1; f <= 24; ++f) REQUIRE_FALSE(w.advanceFrame(f).failed);
-    double top = -1e9;
-    const VecX& x = w.bodies()[0]->positions();
-    for (size_t i = 0; i < w.bodies()[0]->vertexCount(); ++i) top = std::max(top, x[3 * i + 1]);
-    // The sphere's top is at 0.75 + 0.2 at t = 1 s; the cloth rides on it.
-    CHECK(top == Approx(0.95 + s.thickness).margin(0.02));
+    for (Preconditioner pre : {Preconditioner::Multigrid, Preconditioner::BlockJacobi}) {
+        TriMesh mesh = makeGrid(0.6, 0.6, 10, 10, Vec3(-0.3, 0.0, -0.3), Vec3::UnitX(), Vec3::UnitZ());
+        World w(WorldSettings{});
+        w.addBody(std::make_unique<Cloth>("sheet", mesh, stillAirCloth(0.1)));
+        // The expected height is the exact (LDLᵀ) answer: the sheet rides on the sphere. The scene
+        // sits near a bifurcation — the sheet is struck at 1 m/s and a contact near the top is
+        // close to releasing for most of the second — so where the solve error lands decides
+        // whether the sheet hops off the top: at the default 1e-3, multigrid PCG leaves it 2–6 cm
+        // above the sphere (1e-4 and 3e-5, or 1e-5 without warm start, likewise), block Jacobi
+        // happens not to. Solve near-exactly (1e-7: both preconditioners give the LDLᵀ heights to
+        // 1 mm) so the test checks the contact handling, not the preconditioner's error pattern.
+        w.bodies()[0]->options().cgTolerance = 1e-7;
+        w.bodies()[0]->options().preconditioner = pre;
+        Collider s = sphere(Vec3::Zero(), 0.2);
+        s.a = Param::keyed({0.0, 1.0}, {{0, -0.25, 0}, {0, 0.75, 0}}, gale::fields::KeyInterp::Linear);
+        s.friction = 0.5;
+        w.addCollider(s);
+        for (int f = 1; f <= 24; ++f) REQUIRE_FALSE(w.advanceFrame(f).failed);
+        double top = -1e9;
+        const VecX& x = w.bodies()[0]->positions();
+        for (size_t i = 0; i < w.bodies()[0]->vertexCount(); ++i) top = std::max(top, x[3 * i + 1]);
+        // The sphere's top is at 0.75 + 0.2 at t = 1 s; the cloth rides on it.
+        CHECK(top == Approx(0.95 + s.thickness).margin(0.02));
+    }
 }

@@ -366,15 +366,13 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
         st.residual = rNorm / rhsNorm;
         return st;
     }
-    mMultigrid.apply(mR.data(), mZ.data());
+    double rz = mMultigrid.apply(mR.data(), mZ.data());
     mP = mZ;
-    double rz = deterministicDot(mR.data(), mZ.data(), n3);
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     mPartial.assign(chunks, 0.0);
     int it = 0;
     while (it < maxIterations) {
-        mMultigrid.multiply(mP.data(), mQ.data());
-        const double pq = deterministicDot(mP.data(), mQ.data(), n3);
+        const double pq = mMultigrid.multiplyDot(mP.data(), mQ.data()); // q = Â p, pᵀq
         if (!(pq > 0.0) || !std::isfinite(pq)) {
             st.failed = !std::isfinite(pq);
             break;
@@ -398,8 +396,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
         ++it;
         rNorm = std::sqrt(rr);
         if (rNorm <= target || !std::isfinite(rNorm)) break;
-        mMultigrid.apply(mR.data(), mZ.data());
-        const double rzNew = deterministicDot(mR.data(), mZ.data(), n3);
+        const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
         const double beta = rzNew / rz;
         rz = rzNew;
         parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {

@@ -68,6 +68,41 @@ void BsrMatrix::multiply(const double* x, double* y) const {
     });
 }
 
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial) const {
+    const size_t n3 = 3 * static_cast<size_t>(n);
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    const size_t rowsPerChunk = kReduceChunk / 3;
+    partial.assign(chunks, 0.0);
+    parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+        for (size_t ch = c0; ch < c1; ++ch) {
+            const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
+            double s = 0.0;
+            for (size_t i = ch * rowsPerChunk; i < i1; ++i) {
+                double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+                for (int k = start[i]; k < start[i + 1]; ++k) {
+                    const double* b = val.data() + 9 * static_cast<size_t>(k);
+                    const double* xj = x + 3 * static_cast<size_t>(cols[k]);
+                    const double a = xj[0], c = xj[1], d = xj[2];
+                    y0 += b[0] * a + b[1] * c + b[2] * d;
+                    y1 += b[3] * a + b[4] * c + b[5] * d;
+                    y2 += b[6] * a + b[7] * c + b[8] * d;
+                }
+                y[3 * i] = y0;
+                y[3 * i + 1] = y1;
+                y[3 * i + 2] = y2;
+                // In entry order, as deterministicDot sums.
+                s += x[3 * i] * y0;
+                s += x[3 * i + 1] * y1;
+                s += x[3 * i + 2] * y2;
+            }
+            partial[ch] = s;
+        }
+    });
+    double s = 0.0;
+    for (double p : partial) s += p;
+    return s;
+}
+
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: set-up
 
@@ -287,7 +322,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: the V-cycle
 
-void BlockMultigrid::smooth(int l, bool forward, bool fromZero) {
+void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     Level& L = mLevels[l];
     const BsrMatrix& a = L.a;
     const int n = a.n;
@@ -314,9 +349,22 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero) {
                 y2 -= b[6] * p + b[7] * q + b[8] * u;
             }
             const double* d = dinv + 9 * static_cast<size_t>(i);
-            x[3 * i] += d[0] * y0 + d[1] * y1 + d[2] * y2;
-            x[3 * i + 1] += d[3] * y0 + d[4] * y1 + d[5] * y2;
-            x[3 * i + 2] += d[6] * y0 + d[7] * y1 + d[8] * y2;
+            const double x0 = x[3 * i] + d[0] * y0 + d[1] * y1 + d[2] * y2;
+            const double x1 = x[3 * i + 1] + d[3] * y0 + d[4] * y1 + d[5] * y2;
+            const double x2 = x[3 * i + 2] + d[6] * y0 + d[7] * y1 + d[8] * y2;
+            x[3 * i] = x0, x[3 * i + 1] = x1, x[3 * i + 2] = x2;
+            if (!residual) continue;
+            // t_j −= A_ji x_i = A_ijᵀ x_i for the earlier rows j (A symmetric), from the blocks
+            // just read: when the sweep ends, t = r − A x with no second pass over A.
+            double* t = L.t.data();
+            t[3 * i] = t[3 * i + 1] = t[3 * i + 2] = 0.0;
+            for (int k = start[i]; k < end; ++k) {
+                const float* b = val + 9 * static_cast<size_t>(k);
+                double* tj = t + 3 * static_cast<size_t>(cols[k]);
+                tj[0] -= b[0] * x0 + b[3] * x1 + b[6] * x2;
+                tj[1] -= b[1] * x0 + b[4] * x1 + b[7] * x2;
+                tj[2] -= b[2] * x0 + b[5] * x1 + b[8] * x2;
+            }
         }
         return;
     }
@@ -350,25 +398,12 @@ void BlockMultigrid::cycle(int l) {
         return;
     }
     std::fill(L.x.begin(), L.x.end(), 0.0);
-    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, true, s == 0);
     // t = r − A x. After one forward Gauss–Seidel sweep from zero, rows up to i already
-    // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j (half a product).
+    // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j, which that sweep accumulates itself.
     const BsrMatrix& a = L.a;
-    if (mSettings.gaussSeidel && mSettings.sweeps == 1) {
-        parallelChunks(static_cast<size_t>(a.n), 512, [&](size_t i0, size_t i1) {
-            for (size_t i = i0; i < i1; ++i) {
-                double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-                for (int k = a.diag[i] + 1; k < a.start[i + 1]; ++k) {
-                    const float* b = L.lowVal.data() + 9 * static_cast<size_t>(k);
-                    const double* xj = L.x.data() + 3 * static_cast<size_t>(a.cols[k]);
-                    y0 -= b[0] * xj[0] + b[1] * xj[1] + b[2] * xj[2];
-                    y1 -= b[3] * xj[0] + b[4] * xj[1] + b[5] * xj[2];
-                    y2 -= b[6] * xj[0] + b[7] * xj[1] + b[8] * xj[2];
-                }
-                L.t[3 * i] = y0, L.t[3 * i + 1] = y1, L.t[3 * i + 2] = y2;
-            }
-        });
-    } else {
+    const bool fused = mSettings.gaussSeidel && mSettings.sweeps == 1;
+    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, true, s == 0, fused);
+    if (!fused) {
         a.multiply(L.x.data(), L.t.data());
         for (size_t k = 0; k < n3; ++k) L.t[k] = L.r[k] - L.t[k];
     }
@@ -401,12 +436,29 @@ void BlockMultigrid::cycle(int l) {
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
 }
 
-void BlockMultigrid::apply(const double* r, double* z) {
+double BlockMultigrid::apply(const double* r, double* z) {
     Level& L = mLevels[0];
     const size_t n3 = 3 * static_cast<size_t>(L.a.n);
     std::copy(r, r + n3, L.r.begin());
     cycle(0);
-    std::copy(L.x.begin(), L.x.end(), z);
+    // z = x and the chunk sums of rᵀz in one pass.
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    mPartial.assign(chunks, 0.0);
+    const double* x = L.x.data();
+    parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+        for (size_t ch = c0; ch < c1; ++ch) {
+            const size_t e = std::min(n3, (ch + 1) * kReduceChunk);
+            double s = 0.0;
+            for (size_t k = ch * kReduceChunk; k < e; ++k) {
+                z[k] = x[k];
+                s += r[k] * x[k];
+            }
+            mPartial[ch] = s;
+        }
+    });
+    double s = 0.0;
+    for (double p : mPartial) s += p;
+    return s;
 }
 
 } // namespace gale::solver

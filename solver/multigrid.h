@@ -28,6 +28,9 @@ struct BsrMatrix {
     int blocks() const { return static_cast<int>(cols.size()); }
     // y = M x, parallel over rows (deterministic: each row is summed in column order).
     void multiply(const double* x, double* y) const;
+    // y = M x and returns xᵀy, summed in chunks of kReduceChunk entries like deterministicDot
+    // (same bits; one pass over x and y instead of two). `partial` is scratch.
+    double multiplyDot(const double* x, double* y, std::vector<double>& partial) const;
 };
 
 // Plain (unsmoothed) aggregation AMG with a constraint-filtered tentative prolongator:
@@ -58,10 +61,13 @@ public:
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates are built
     // when the pattern of A is new. Returns false when a value is not finite.
     bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained);
-    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero).
-    void apply(const double* r, double* z);
+    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero); returns rᵀz
+    // summed as deterministicDot does (fused with the copy-out).
+    double apply(const double* r, double* z);
     // y = Â x with the level-0 copy.
     void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
+    // y = Â x and returns xᵀÂx (deterministicDot's summation order).
+    double multiplyDot(const double* x, double* y) { return mLevels[0].a.multiplyDot(x, y, mPartial); }
 
     int levelCount() const { return static_cast<int>(mLevels.size()); }
     int rows(int level) const { return mLevels[level].a.n; }
@@ -80,12 +86,14 @@ private:
     void buildHierarchy(const BlockMatrix& A);
     void aggregate(Level& fine, Level& coarse);
     void coarsen(int l);
-    void smooth(int l, bool forward, bool fromZero);
+    // residual: (forward from zero only) also leave t = r − A x in L.t.
+    void smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
 
     Settings mSettings;
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
+    std::vector<double> mPartial; // chunk sums of the fused dot products
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;

@@ -170,12 +170,14 @@ TEST_CASE("multigrid: the scene key picks the preconditioner; a bad value is an 
         for (const auto& e : errs) errors += e.render() + "\n";
         return ok;
     };
-    SimScene a, b, c;
-    std::string ea, eb, ec;
+    SimScene a, b, c, d;
+    std::string ea, eb, ec, ed;
     REQUIRE(load("", a, ea));
-    CHECK(a.cloths[0].step.preconditioner == Preconditioner::BlockJacobi);
+    CHECK(a.cloths[0].step.preconditioner == Preconditioner::Multigrid); // the default
     REQUIRE(load("\"multigrid\"", b, eb));
     CHECK(b.cloths[0].step.preconditioner == Preconditioner::Multigrid);
+    REQUIRE(load("\"jacobi\"", d, ed));
+    CHECK(d.cloths[0].step.preconditioner == Preconditioner::BlockJacobi);
     CHECK_FALSE(load("\"amg\"", c, ec));
     INFO(ec);
     CHECK(ec.find(path + ":4:18: error: unknown preconditioner 'amg'") != std::string::npos);
