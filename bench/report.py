@@ -86,7 +86,8 @@ def vm_precision(out, figdir, notes):
         notes.append("VM precision: no rows recognised in gale_bench_vm's output.")
         return None
     fig, ax = plt.subplots(figsize=(7, 3.2))
-    labels = [r[0][:28] for r in rows]
+    # '$' would start matplotlib mathtext ($P[0] …); show the expression as written.
+    labels = [(r[0][:32] + ("…" if len(r[0]) > 32 else "")).replace("$", r"\$") for r in rows]
     xs = range(len(rows))
     ax.bar([x - 0.27 for x in xs], [r[1] for r in rows], 0.27, label="hand-written C++ (float)")
     ax.bar(list(xs), [r[2] for r in rows], 0.27, label="VM float")
@@ -97,7 +98,8 @@ def vm_precision(out, figdir, notes):
     ax.set_xticklabels(labels, fontsize=8)
     ax.set_ylabel("ns per point")
     ax.set_title("VM precision: float is faster; its error against double")
-    ax.legend(fontsize=8)
+    ax.set_ylim(0, 1.2 * max(max(r[1:4]) for r in rows))
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     path = os.path.join(figdir, "vm_precision.png")
     fig.savefig(path, dpi=110)

@@ -6,6 +6,7 @@
 #include "fields/geometry.h"
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
@@ -15,6 +16,8 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <fstream>
+#include <stdexcept>
 
 namespace gale::fields {
 
@@ -140,14 +143,23 @@ IoError writeVdbVelocity(const std::string& path, const GridSpec& spec,
     });
 }
 
+// Every grid of a .vdb file, read through a stream that throws on a short read. OpenVDB's
+// io::File does not check its reads: on a truncated file it takes a block size it never read
+// and asks new[] for that many bytes (docs/sanitizers.md), so a cut-off cache could allocate
+// gigabytes or read garbage. A failed read here is an exception, reported as a corrupt file.
+openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot open the file");
+    in.exceptions(std::ios::failbit | std::ios::badbit);
+    openvdb::io::Stream stream(in, /*delayLoad=*/false);
+    return stream.getGrids();
+}
+
 IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out) {
     initOpenVdb();
     openvdb::GridPtrVecPtr grids;
     try {
-        openvdb::io::File file(path);
-        file.open();
-        grids = file.getGrids();
-        file.close();
+        grids = readAllGrids(path);
     } catch (const std::exception& e) {
         return makeError(IoError::Io, path, std::string("cannot read: ") + e.what());
     }
@@ -288,10 +300,7 @@ VelocityVolume::~VelocityVolume() = default;
 IoError checkVdbGrid(const std::string& path, const std::string& gridName) {
     initOpenVdb();
     try {
-        openvdb::io::File file(path);
-        file.open(false);
-        openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
-        file.close();
+        openvdb::GridPtrVecPtr grids = readAllGrids(path);
         openvdb::GridBase::Ptr grid;
         return pickVectorGrid(path, gridName, *grids, grid);
     } catch (const std::exception& e) {
@@ -304,15 +313,9 @@ IoError VelocityVolume::load(const std::string& path, const std::string& gridNam
     initOpenVdb();
     openvdb::GridBase::Ptr grid;
     try {
-        openvdb::io::File file(path);
-        file.open(false); // read everything now: a truncated file fails here, not mid-sample
-        openvdb::GridPtrVecPtr descriptors = file.readAllGridMetadata();
-        if (IoError e = pickVectorGrid(path, gridName, *descriptors, grid)) {
-            file.close();
-            return e;
-        }
-        grid = file.readGrid(grid->getName());
-        file.close();
+        // Everything is read now: a truncated file fails here, not mid-sample.
+        openvdb::GridPtrVecPtr grids = readAllGrids(path);
+        if (IoError e = pickVectorGrid(path, gridName, *grids, grid)) return e;
     } catch (const std::exception& e) {
         return readFailure(path, e);
     }
