@@ -49,22 +49,25 @@ Mat3 filterOf(uint8_t kind, const double* normal) {
 // ---------------------------------------------------------------------------------------------
 // BsrMatrix
 
+// yi = Σ_k A_ik x_k over block row i: the three entries of row i of A x.
+static void blockRowProduct(const BsrMatrix& m, size_t i, const double* x, double* yi) {
+    double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+    for (int k = m.start[i]; k < m.start[i + 1]; ++k) {
+        const double* b = m.val.data() + 9 * static_cast<size_t>(k);
+        const double* xj = x + 3 * static_cast<size_t>(m.cols[k]);
+        const double a = xj[0], c = xj[1], d = xj[2];
+        y0 += b[0] * a + b[1] * c + b[2] * d;
+        y1 += b[3] * a + b[4] * c + b[5] * d;
+        y2 += b[6] * a + b[7] * c + b[8] * d;
+    }
+    yi[0] = y0;
+    yi[1] = y1;
+    yi[2] = y2;
+}
+
 void BsrMatrix::multiply(const double* x, double* y) const {
     parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) {
-            double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-            for (int k = start[i]; k < start[i + 1]; ++k) {
-                const double* b = val.data() + 9 * static_cast<size_t>(k);
-                const double* xj = x + 3 * static_cast<size_t>(cols[k]);
-                const double a = xj[0], c = xj[1], d = xj[2];
-                y0 += b[0] * a + b[1] * c + b[2] * d;
-                y1 += b[3] * a + b[4] * c + b[5] * d;
-                y2 += b[6] * a + b[7] * c + b[8] * d;
-            }
-            y[3 * i] = y0;
-            y[3 * i + 1] = y1;
-            y[3 * i + 2] = y2;
-        }
+        for (size_t i = i0; i < i1; ++i) blockRowProduct(*this, i, x, y + 3 * i);
     });
 }
 
@@ -78,18 +81,8 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
             const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
             double s = 0.0;
             for (size_t i = ch * rowsPerChunk; i < i1; ++i) {
-                double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-                for (int k = start[i]; k < start[i + 1]; ++k) {
-                    const double* b = val.data() + 9 * static_cast<size_t>(k);
-                    const double* xj = x + 3 * static_cast<size_t>(cols[k]);
-                    const double a = xj[0], c = xj[1], d = xj[2];
-                    y0 += b[0] * a + b[1] * c + b[2] * d;
-                    y1 += b[3] * a + b[4] * c + b[5] * d;
-                    y2 += b[6] * a + b[7] * c + b[8] * d;
-                }
-                y[3 * i] = y0;
-                y[3 * i + 1] = y1;
-                y[3 * i + 2] = y2;
+                blockRowProduct(*this, i, x, y + 3 * i);
+                const double y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];
                 // In entry order, as deterministicDot sums.
                 s += x[3 * i] * y0;
                 s += x[3 * i + 1] * y1;

@@ -4,17 +4,6 @@
 # killed writers' temporary files and ends with the same sequence byte for byte.
 source "$(dirname "$0")/lib.bash" "$@"
 
-# wait_file FILE [PID]: polls until FILE exists (at most about 15 s), or PID has ended.
-wait_file() {
-    local i
-    for ((i = 0; i < 3000; i++)); do
-        [ -e "$1" ] && return 0
-        [ -n "${2:-}" ] && ! kill -0 "$2" 2> /dev/null && return 1
-        sleep 0.005
-    done
-    return 1
-}
-
 EXPR='[sin(3 * $P[0] + $t) * noise($P * 2 + $t), cos(2 * $P[1] - $t), noise($P * 3 - [$t, 0, 0])]'
 GRID=(--bounds 0,0,0,2,1,1 --res 48,24,24 --threads 1) # 27648 cells
 FRAMES=1:30

@@ -5,17 +5,6 @@
 # aside). A re-run while orphans still write is refused per variant, never interleaved.
 source "$(dirname "$0")/lib.bash" "$@"
 
-# wait_file FILE [PID]: polls until FILE exists (at most about 15 s), or PID has ended.
-wait_file() {
-    local i
-    for ((i = 0; i < 3000; i++)); do
-        [ -e "$1" ] && return 0
-        [ -n "${2:-}" ] && ! kill -0 "$2" 2> /dev/null && return 1
-        sleep 0.005
-    done
-    return 1
-}
-
 cat > tiny.toml <<'TOML'
 [scene]
 fps = 24

@@ -50,3 +50,14 @@ finish() {
     echo "ok"
     exit 0
 }
+
+# wait_file FILE [PID]: polls until FILE exists (at most about 15 s), or PID has ended.
+wait_file() {
+    local i
+    for ((i = 0; i < 3000; i++)); do
+        [ -e "$1" ] && return 0
+        [ -n "${2:-}" ] && ! kill -0 "$2" 2> /dev/null && return 1
+        sleep 0.005
+    done
+    return 1
+}
