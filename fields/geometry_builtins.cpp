@@ -173,7 +173,7 @@ struct VdbK {
         std::shared_ptr<const FileRef> ref = ctx ? ctx->find(f.args[0].string(0), error) : nullptr;
         if (!ref) return fail(f, ctx, 0, f.n, error);
         const std::string& grid = f.args[1].string(0);
-        const int code = static_cast<int>(f.args[3].at(0, 0));
+        const double code = static_cast<double>(f.args[3].at(0, 0)); // not cast to int: may be NaN
         const VolumeInterp interp = code == 0   ? VolumeInterp::Nearest
                                     : code == 2 ? VolumeInterp::Quadratic
                                                 : VolumeInterp::Trilinear;
@@ -272,6 +272,13 @@ struct MeshVelK {
         const double voxel = static_cast<double>(f.args[3].at(0, 0));
         const double falloff = std::max(static_cast<double>(f.args[2].at(0, 0)), voxel);
         const double fps = f.nargs > 5 ? static_cast<double>(f.args[5].at(0, 0)) : 24.0;
+        // A uniform (non-constant) voxel or falloff is only known now: check it before it
+        // becomes a voxel count (a NaN or out-of-range value converted to int is undefined).
+        if (!(voxel > 0.0 && std::isfinite(voxel) && std::isfinite(falloff) &&
+              falloff / voxel <= 1e6))
+            return fail(f, ctx, 0, f.n,
+                        "meshvel(): voxel must be a positive number of metres and falloff at "
+                        "most a million voxels");
         const int band = static_cast<int>(std::ceil(falloff / voxel));
         double xyz[3 * kBlockSize];
         int32_t cand[8 * kBlockSize];

@@ -158,6 +158,18 @@ TEST_CASE("meshvel(): the velocity of a moving sphere near its surface, faded by
     // fps scales the velocity (m per frame * frames per second).
     CHECK(sampleAt(*c.field, {0.1, 0.3, 0}, 2.0 / 30.0, 30.0)[0] ==
           Approx(0.05 * 30.0).epsilon(0.02));
+    // A far-away or NaN point has no nearby triangle: no velocity, and no crash.
+    CHECK(sampleAt(*c.field, {1e12, 0, 0}, t, fps)[0] == 0.0);
+    const double atNan = sampleAt(*c.field, {std::nan(""), 0, 0}, t, fps)[0];
+    CHECK((std::isnan(atNan) || atNan == 0.0));
+    // A uniform voxel of 0 is only known at evaluation: the kernel fails (NaN, which the field
+    // reports and zeroes) instead of converting an infinite voxel count to int (undefined;
+    // caught by the float-cast-overflow sanitizer in `make test-asan`).
+    Compiled z = compileIn(dir, "$vox = 0.0;\nmeshvel(\"body.#.obj\", $P, 0.2, $vox)");
+    INFO(z.diagnostics);
+    REQUIRE(z.field);
+    const double atZero = sampleAt(*z.field, {0.1, 0.3, 0}, t, fps)[0];
+    CHECK((std::isnan(atZero) || atZero == 0.0));
 }
 
 TEST_CASE("geometry diagnostics point at the argument and name the file",

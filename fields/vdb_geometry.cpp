@@ -316,9 +316,15 @@ void ClosestTriangleIndex::candidates(const double* xyz, size_t n, int32_t* out)
     auto acc = m.grid->getConstAccessor();
     for (size_t i = 0; i < n; ++i) {
         const double* p = xyz + 3 * i;
-        const openvdb::Coord base(static_cast<int>(std::floor(p[0] / m.voxel)),
-                                  static_cast<int>(std::floor(p[1] / m.voxel)),
-                                  static_cast<int>(std::floor(p[2] / m.voxel)));
+        const double g[3] = {std::floor(p[0] / m.voxel), std::floor(p[1] / m.voxel),
+                             std::floor(p[2] / m.voxel)};
+        // A NaN or far-away point has no candidates (and must not be converted to int).
+        if (!(std::fabs(g[0]) < 1e9 && std::fabs(g[1]) < 1e9 && std::fabs(g[2]) < 1e9)) {
+            for (int c = 0; c < 8; ++c) out[8 * i + static_cast<size_t>(c)] = -1;
+            continue;
+        }
+        const openvdb::Coord base(static_cast<int>(g[0]), static_cast<int>(g[1]),
+                                  static_cast<int>(g[2]));
         for (int c = 0; c < 8; ++c) {
             const openvdb::Coord q = base.offsetBy(c & 1, (c >> 1) & 1, (c >> 2) & 1);
             int32_t v = -1;
