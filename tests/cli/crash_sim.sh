@@ -93,17 +93,19 @@ kill_after() {
     check_dir "$dir" "killed after ${file:-start} + ${delay}s"
 }
 
-# Kills right after frame k appears, each continuing the last (so the run crawls forward).
+# Kills at short fixed delays after the start (loading, the first frames, mid-write), each
+# continuing the last (so the run crawls forward).
 mkdir run
-for k in 0003 0007 0012 0018 0024; do
-    kill_after run "flag.$k.obj" 0
-done
-# Kills at short fixed delays after the start (loading, the first frames, mid-write).
 RANDOM=8 # fixed seed: the same delays every time
 for i in 1 2 3 4 5 6; do
     kill_after run "" "0.0$((RANDOM % 10))$((RANDOM % 10))"
 done
-[ "$KILLS" -ge 8 ] || fail "most runs were killed before they finished ($KILLS kills)"
+# Then kills right after frame k appears (at once when the delays already got past it). These
+# land whatever the machine's speed; the delayed ones may find the run finished on a fast one.
+for k in 0003 0007 0012 0018 0024; do
+    kill_after run "flag.$k.obj" 0
+done
+[ "$KILLS" -ge 5 ] || fail "most runs were killed before they finished ($KILLS kills)"
 
 # A temporary file of a killed writer is not a frame: plant two (a dead process's pid) and see
 # the resume remove them.
