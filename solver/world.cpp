@@ -127,7 +127,7 @@ namespace {
 void putU64(std::string& s, uint64_t v) { s.append(reinterpret_cast<const char*>(&v), 8); }
 void putVec(std::string& s, const VecX& v) {
     putU64(s, static_cast<uint64_t>(v.size()));
-    s.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
+    if (v.size() > 0) s.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
 }
 struct Reader {
     const std::string& s;
@@ -150,7 +150,7 @@ struct Reader {
             return VecX();
         }
         VecX v(static_cast<long>(n));
-        std::memcpy(v.data(), s.data() + pos, sizeof(double) * n);
+        if (n > 0) std::memcpy(v.data(), s.data() + pos, sizeof(double) * n); // data() is null when empty
         pos += sizeof(double) * n;
         return v;
     }
