@@ -2,6 +2,7 @@
 # Runs the libFuzzer harnesses for a bounded time: fuzz/run.sh BUILD_DIR SECONDS [HARNESS...].
 # Each harness fuzzes BUILD_DIR/corpus/<harness> (grown in place) for SECONDS, two at a time;
 # crash, leak and timeout inputs land in BUILD_DIR/fuzz-artifacts/. Exit 1 if any harness failed.
+# FUZZ_SEED=N fixes libFuzzer's random seed (CI does, so a submission's run is reproducible).
 set -u
 BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [HARNESS...]}
 SECONDS_EACH=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [HARNESS...]}
@@ -26,7 +27,7 @@ run_one() {
     mkdir -p "$BUILD/corpus/$h"
     # shellcheck disable=SC2046
     "$BUILD/fuzz/$h" "$BUILD/corpus/$h" $(dict_for "$h") -max_total_time="$SECONDS_EACH" \
-        -timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1 \
+        ${FUZZ_SEED:+-seed=$FUZZ_SEED} -timeout=10 -rss_limit_mb=2048 -max_len=8192 -print_final_stats=1 \
         -artifact_prefix="$ART/$h-" >"$BUILD/fuzz-$h.log" 2>&1
     echo $? >"$BUILD/fuzz-$h.rc"
 }
