@@ -1,5 +1,6 @@
 // Tests for removeStaleTempFiles: temporary files of killed writers (dead or zombie pids) are
 // removed, those of running processes and names the caller does not own are kept.
+#include "fields/test_support.h"
 #include "fields/atomic_file.h"
 
 #include <catch2/catch.hpp>
@@ -17,17 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("gale_atomic_test_" + std::to_string(::getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct TempDir : test::TempDir {
     void touch(const std::string& name) const { std::ofstream(path / name) << "half"; }
     bool has(const std::string& name) const { return fs::exists(path / name); }
 };

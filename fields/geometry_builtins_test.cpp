@@ -2,6 +2,7 @@
 // and closed forms, meshvel() gives a translating sphere's velocity with its falloff, scenes
 // resolve names against their folder, and every misuse is a diagnostic at the argument's
 // file:line:col naming the file (missing, outside the folder, not constant, varying settings).
+#include "fields/test_support.h"
 #include "fields/expression_field.h"
 #include "fields/geometry.h"
 #include "lang/diagnostics.h"
@@ -18,20 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        static int n = 0;
-        path = fs::canonical(fs::temp_directory_path()) /
-               ("gale_geombuiltin_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using test::TempDir;
 
 struct Compiled {
     std::shared_ptr<ExpressionField> field;

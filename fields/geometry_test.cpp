@@ -2,6 +2,7 @@
 // within one voxel of the analytic distance, unit gradients along the analytic normal, the wind
 // shadow's bounds and monotonicity behind a sphere, closest points on triangles, mesh reading
 // (polygons fanned, errors) and the cache's once-per-key rule.
+#include "fields/test_support.h"
 #include "fields/geometry.h"
 #include "fields/geometry_cache.h"
 
@@ -20,20 +21,7 @@ using namespace gale::fields;
 
 namespace {
 
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        static int n = 0;
-        path = std::filesystem::temp_directory_path() /
-               ("gale_geometry_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using test::TempDir;
 
 void writeText(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;

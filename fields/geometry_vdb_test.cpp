@@ -2,6 +2,7 @@
 // quadratics exactly with quadratic interpolation, smooth fields within the trilinear error
 // bound; `gale sample`'s .vdb reads back identically at cell centres; `#` sequences blend
 // frames; missing, truncated, garbage and wrong-grid files are clear errors.
+#include "fields/test_support.h"
 #include "fields/expression_field.h"
 #include "fields/geometry.h"
 #include "fields/vdb_io.h"
@@ -21,20 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        static int n = 0;
-        path = fs::canonical(fs::temp_directory_path()) /
-               ("gale_geomvdb_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using test::TempDir;
 
 GridSpec testGrid() {
     GridSpec g;

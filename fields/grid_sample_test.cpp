@@ -1,6 +1,7 @@
 // Tests for grid sampling: geometry from bounds, cell-centred values of an analytic field
 // (independent of threads and batch size), non-finite counting, the .npy and .csv grid
 // writers, atomic files and frame-numbered names.
+#include "fields/test_support.h"
 #include "fields/grid_sample.h"
 
 #include <catch2/catch.hpp>
@@ -58,22 +59,7 @@ public:
     std::string describe() const override { return "bad"; }
 };
 
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("gale_grid_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter()++));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    static int& counter() {
-        static int n = 0;
-        return n;
-    }
-};
+using test::TempDir;
 
 float readFloatLE(const std::string& bytes, size_t at) {
     uint32_t u = 0;

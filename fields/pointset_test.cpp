@@ -1,5 +1,6 @@
 // Tests for point-set I/O: round trips through every format, arbitrary and big-endian PLY,
 // faces, malformed files reported at the right line, number formatting, host variables.
+#include "fields/test_support.h"
 #include "fields/pointset.h"
 
 #include <catch2/catch.hpp>
@@ -56,17 +57,7 @@ PointSet sample() {
 }
 
 // A temporary folder removed at the end of the test.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        path = std::filesystem::temp_directory_path() /
-               ("gale_pointset_test_" + std::to_string(::getpid()) + "_" +
-                std::to_string(std::rand()));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() { std::filesystem::remove_all(path); }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using test::TempDir;
 
 template <class T>
 void putBE(std::string& s, T v) {

@@ -1,6 +1,7 @@
 // Tests for scene loading: every key of [scene], [windicator], [[gust]] and [[field]], keyframed
 // values, --set overrides by dotted path, and bad input reported at file:line:col (all of it,
 // with "did you mean"); then the scene's summed field built and sampled.
+#include "fields/test_support.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
 
@@ -17,25 +18,7 @@ using namespace gale::fields;
 namespace {
 
 // A scratch folder per test, removed afterwards.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        static std::atomic<int> counter{0};
-        path = std::filesystem::temp_directory_path() /
-               ("gale_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    std::string write(const std::string& name, const std::string& text) const {
-        const std::filesystem::path p = path / name;
-        std::filesystem::create_directories(p.parent_path());
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
-};
+using test::TempDir;
 
 struct Loaded {
     Scene scene;

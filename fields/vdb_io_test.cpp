@@ -1,6 +1,7 @@
 // Tests for the .vdb velocity files: a written grid read back has the same values, voxel size,
 // origin, name, vector type and box (uniform regions included); errors for missing files,
 // missing grids and wrong value counts.
+#include "fields/test_support.h"
 #include "fields/vdb_io.h"
 
 #include <catch2/catch.hpp>
@@ -14,20 +15,7 @@ using namespace gale::fields;
 
 namespace {
 
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        static int n = 0;
-        path = std::filesystem::temp_directory_path() /
-               ("gale_vdb_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using test::TempDir;
 
 // Values derived from the cell index (not from any sampling code): distinct per cell and
 // component, with a zero region (cells with i == 0) and a constant region (i == nx-1).
