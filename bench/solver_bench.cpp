@@ -1,14 +1,16 @@
 // gale_bench_solver: speed against error for the implicit cloth solver, next to an explicit
 // symplectic-Euler baseline measured in the same run; cost per vertex per step and CG
 // iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix.
-//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability]
-//   (DIR gets CSV tables and SVG plots; --only runs one section)
+//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size N]
+//   [--solver NAME]  (DIR gets CSV tables and SVG plots; --only runs one section; --size N and
+//   --solver NAME keep only those rows of the scaling table, e.g. to profile one of them)
 #include "solver/cloth.h"
 #include "solver/world.h"
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -329,7 +331,7 @@ void setSolver(World& w, const SolverChoice& s) {
     b.options().preconditioner = s.pre;
 }
 
-void scalingBench(bool quick) {
+void scalingBench(bool quick, int onlySize, const std::string& onlySolver) {
     std::printf("\n## Cost per vertex per step, one thread: flag 1 m, sigma 0.1 kg/m^2, stretch 2000 N/m, gusty 12 m/s,"
                 " h = 1/240 s, CG tol 1e-3, block-Jacobi and multigrid PCG and the sparse LDL^T in the same run"
                 " (CPU: process CPU time, robust on a shared machine)\n\n");
@@ -337,6 +339,8 @@ void scalingBench(bool quick) {
                 "|---|---|---|---|---|---|\n");
     for (int n : {32, 64, 128})
         for (const SolverChoice& s : kSolvers) {
+            if (onlySize > 0 && n != onlySize) continue;
+            if (!onlySolver.empty() && std::string(s.name).find(onlySolver) == std::string::npos) continue;
             if (quick && n == 128) continue;
             if (n == 128 && s.kind == LinearSolverKind::Direct) continue;
             FlagSpec f;
@@ -352,6 +356,7 @@ void scalingBench(bool quick) {
                         per * 1e6 / (n * n), cpu * 1e3, double(r.iterations) / std::max<long>(r.substeps, 1));
         }
     // The real-time check: 32x32 at 24 fps with 4 substeps (h = 1/96 s).
+    if ((onlySize > 0 && onlySize != 32) || !onlySolver.empty()) return;
     std::printf("\n");
     for (int k = 0; k < 2; ++k) {
         FlagSpec f;
@@ -420,19 +425,26 @@ void stabilityBench(bool quick) {
 int main(int argc, char** argv) {
     bool quick = false;
     std::string out, only;
+    int onlySize = 0;
+    std::string onlySolver;
+    const char* usage =
+        "usage: gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size 32|64|128]\n"
+        "       [--solver Jacobi|multigrid|direct]\n";
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+        else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) onlySize = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--solver") && i + 1 < argc) onlySolver = argv[++i];
         else {
-            std::fprintf(stderr, "usage: gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability]\n");
+            std::fprintf(stderr, "%s", usage);
             return 2;
         }
     }
     std::printf("# gale_bench_solver%s\n", quick ? " (--quick)" : "");
     if (only.empty() || only == "plate") plateBench(quick, out);
     if (only.empty() || only == "flag") flagBench(quick, out);
-    if (only.empty() || only == "scaling") scalingBench(quick);
+    if (only.empty() || only == "scaling") scalingBench(quick, onlySize, onlySolver);
     if (only.empty() || only == "stability") stabilityBench(quick);
     return 0;
 }

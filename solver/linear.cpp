@@ -29,35 +29,14 @@ void BlockMatrix::build(int n, const std::vector<std::pair<int, int>>& pairs) {
         mBlockRowStart[i + 1] = mBlockRowStart[i] + static_cast<int>(rows[i].size());
         mBlockCols.insert(mBlockCols.end(), rows[i].begin(), rows[i].end());
     }
-    // Scalar CSR: row 3i+a holds 3 entries per block of block row i, columns sorted.
-    const int nnz = 9 * static_cast<int>(mBlockCols.size());
-    mA = Eigen::SparseMatrix<double, Eigen::RowMajor>(3 * n, 3 * n);
-    mA.resizeNonZeros(nnz);
-    int* outer = mA.outerIndexPtr();
-    int* inner = mA.innerIndexPtr();
-    int pos = 0;
-    for (int i = 0; i < n; ++i) {
-        const int nb = mBlockRowStart[i + 1] - mBlockRowStart[i];
-        for (int a = 0; a < 3; ++a) {
-            outer[3 * i + a] = pos;
-            for (int k = mBlockRowStart[i]; k < mBlockRowStart[i + 1]; ++k)
-                for (int c = 0; c < 3; ++c) inner[pos++] = 3 * mBlockCols[k] + c;
-        }
-        (void)nb;
-    }
-    outer[3 * n] = pos;
-    std::fill(mA.valuePtr(), mA.valuePtr() + nnz, 0.0);
-    mSlotBase.resize(mBlockCols.size());
-    mSlotStride.resize(mBlockCols.size());
+    mVal.assign(9 * mBlockCols.size() + kBsrPad, 0.0);
     mDiagSlot.assign(n, -1);
-    for (int i = 0; i < n; ++i) {
-        const int nb = mBlockRowStart[i + 1] - mBlockRowStart[i];
+    mMirror.resize(mBlockCols.size());
+    for (int i = 0; i < n; ++i)
         for (int k = mBlockRowStart[i]; k < mBlockRowStart[i + 1]; ++k) {
-            mSlotBase[k] = outer[3 * i] + 3 * (k - mBlockRowStart[i]);
-            mSlotStride[k] = 3 * nb;
             if (mBlockCols[k] == i) mDiagSlot[i] = k;
+            mMirror[k] = slot(mBlockCols[k], i);
         }
-    }
 }
 
 int BlockMatrix::slot(int i, int j) const {
@@ -66,63 +45,42 @@ int BlockMatrix::slot(int i, int j) const {
     return (it != e && *it == j) ? static_cast<int>(it - mBlockCols.begin()) : -1;
 }
 
-void BlockMatrix::setZero() {
-    std::fill(mA.valuePtr(), mA.valuePtr() + mA.nonZeros(), 0.0);
-}
-
-Mat3 BlockMatrix::block(int slot) const {
-    const double* p = mA.valuePtr() + mSlotBase[slot];
-    const int s = mSlotStride[slot];
-    Mat3 m;
-    for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) m(a, c) = p[a * s + c];
-    return m;
-}
-
-void BlockMatrix::setBlock(int slot, const Mat3& b) {
-    double* p = mA.valuePtr() + mSlotBase[slot];
-    const int s = mSlotStride[slot];
-    for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) p[a * s + c] = b(a, c);
-}
-
-namespace {
-template <class V>
-void blockMultiply(const int* outer, const V* val, const int* cols, const int* start, int n, const double* x,
-                   double* y) {
-    // Block row i: its three scalar rows are contiguous runs of 3·nb values; block k of the
-    // row holds columns 3j..3j+2, so each x block is loaded once for 9 products.
-    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) {
-            const int nb = start[i + 1] - start[i];
-            const V* v0 = val + outer[3 * i];
-            const V* v1 = v0 + 3 * nb;
-            const V* v2 = v1 + 3 * nb;
-            const int* c = cols + start[i];
-            double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-            for (int k = 0; k < nb; ++k) {
-                const double* xj = x + 3 * c[k];
-                const double a = xj[0], b = xj[1], d = xj[2];
-                y0 += v0[3 * k] * a;
-                y0 += v0[3 * k + 1] * b;
-                y0 += v0[3 * k + 2] * d;
-                y1 += v1[3 * k] * a;
-                y1 += v1[3 * k + 1] * b;
-                y1 += v1[3 * k + 2] * d;
-                y2 += v2[3 * k] * a;
-                y2 += v2[3 * k + 1] * b;
-                y2 += v2[3 * k + 2] * d;
-            }
-            y[3 * i] = y0;
-            y[3 * i + 1] = y1;
-            y[3 * i + 2] = y2;
-        }
-    });
-}
-} // namespace
+void BlockMatrix::setZero() { std::fill(mVal.begin(), mVal.end(), 0.0); }
 
 void BlockMatrix::multiply(const double* x, double* y) const {
-    blockMultiply(mA.outerIndexPtr(), mA.valuePtr(), mBlockCols.data(), mBlockRowStart.data(), mN, x, y);
+    const BsrPattern p = pattern();
+    parallelChunks(static_cast<size_t>(mN), 512,
+                   [&](size_t i0, size_t i1) { bsrMultiplyRows(p, mVal.data(), x, y, i0, i1); });
+}
+
+void BlockMatrix::toScalar(ScalarMatrix& out) const {
+    // Column 3j+a lists, for each block (i, j) of block column j — the blocks of block row j,
+    // the pattern being symmetric — the rows 3i .. 3i+2: entry (3i+r, 3j+a) is
+    // values[9·slot(i, j) + 3a + r].
+    const long nnz = 9 * static_cast<long>(mBlockCols.size());
+    if (out.rows() != 3 * mN || out.cols() != 3 * mN || out.nonZeros() != nnz) {
+        out = ScalarMatrix(3 * mN, 3 * mN);
+        out.resizeNonZeros(nnz);
+        int* outer = out.outerIndexPtr();
+        int* inner = out.innerIndexPtr();
+        int pos = 0;
+        for (int j = 0; j < mN; ++j)
+            for (int a = 0; a < 3; ++a) {
+                outer[3 * j + a] = pos;
+                for (int k = mBlockRowStart[j]; k < mBlockRowStart[j + 1]; ++k)
+                    for (int r = 0; r < 3; ++r) inner[pos++] = 3 * mBlockCols[k] + r;
+            }
+        outer[3 * mN] = pos;
+    }
+    double* v = out.valuePtr();
+    for (int j = 0; j < mN; ++j)
+        for (int a = 0; a < 3; ++a)
+            for (int k = mBlockRowStart[j]; k < mBlockRowStart[j + 1]; ++k) {
+                const double* b = mVal.data() + 9 * static_cast<size_t>(mMirror[k]) + 3 * a;
+                *v++ = b[0];
+                *v++ = b[1];
+                *v++ = b[2];
+            }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -335,6 +293,13 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
 
 // PCG on Â (its BSR copy in the multigrid's level 0) with one symmetric V-cycle as the
 // preconditioner; reductions in fixed chunks as above.
+//
+// Mixed precision: for tolerances ≥ kSinglePrecisionTolerance the products q = Â p read the
+// single-precision copy of Â, whose entries differ from Â's by a relative 6e-8 — far below
+// the tolerance, as the forward error of stopping at it is cond(Â)·tol. The solution is then
+// checked against Â in double (r = rhs − Â y); should that residual miss the tolerance, CG
+// restarts from y with double-precision products (residual replacement). The reported
+// residual is always the double-precision one.
 SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
                                               VecX& y, double tolerance, int maxIterations) {
     SolveStatus st;
@@ -357,51 +322,56 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     mZ.resize(n3);
     mP.resize(n3);
     mQ.resize(n3);
-    mMultigrid.multiply(y.data(), mQ.data());
-    mR = rhs - mQ;
-    double rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
     const double target = tolerance * rhsNorm;
-    if (rNorm <= target) {
-        st.converged = true;
-        st.residual = rNorm / rhsNorm;
-        return st;
-    }
-    double rz = mMultigrid.apply(mR.data(), mZ.data());
-    mP = mZ;
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     mPartial.assign(chunks, 0.0);
+    // r = rhs − Â y in double; returns ‖r‖.
+    auto trueResidual = [&] {
+        mMultigrid.multiply(y.data(), mQ.data());
+        mR = rhs - mQ;
+        return std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+    };
+    double rNorm = trueResidual();
     int it = 0;
-    while (it < maxIterations) {
-        const double pq = mMultigrid.multiplyDot(mP.data(), mQ.data()); // q = Â p, pᵀq
-        if (!(pq > 0.0) || !std::isfinite(pq)) {
-            st.failed = !std::isfinite(pq);
-            break;
-        }
-        const double alpha = rz / pq;
-        // y += α p; r −= α q; partial sums of r·r.
-        parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
-            for (size_t ch = c0; ch < c1; ++ch) {
-                const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
-                double rr = 0.0;
-                for (size_t k = b; k < e; ++k) {
-                    y[k] += alpha * mP[k];
-                    mR[k] -= alpha * mQ[k];
-                    rr += mR[k] * mR[k];
-                }
-                mPartial[ch] = rr;
-            }
-        });
-        double rr = 0.0;
-        for (size_t ch = 0; ch < chunks; ++ch) rr += mPartial[ch];
-        ++it;
-        rNorm = std::sqrt(rr);
+    for (bool single = tolerance >= kSinglePrecisionTolerance;; single = false) {
         if (rNorm <= target || !std::isfinite(rNorm)) break;
-        const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
-        const double beta = rzNew / rz;
-        rz = rzNew;
-        parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
-            for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
-        });
+        double rz = mMultigrid.apply(mR.data(), mZ.data());
+        mP = mZ;
+        while (it < maxIterations) {
+            const double pq = mMultigrid.multiplyDot(mP.data(), mQ.data(), single); // q = Â p, pᵀq
+            if (!(pq > 0.0) || !std::isfinite(pq)) {
+                st.failed = !std::isfinite(pq);
+                break;
+            }
+            const double alpha = rz / pq;
+            // y += α p; r −= α q; partial sums of r·r.
+            parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+                for (size_t ch = c0; ch < c1; ++ch) {
+                    const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
+                    double rr = 0.0;
+                    for (size_t k = b; k < e; ++k) {
+                        y[k] += alpha * mP[k];
+                        mR[k] -= alpha * mQ[k];
+                        rr += mR[k] * mR[k];
+                    }
+                    mPartial[ch] = rr;
+                }
+            });
+            double rr = 0.0;
+            for (size_t ch = 0; ch < chunks; ++ch) rr += mPartial[ch];
+            ++it;
+            rNorm = std::sqrt(rr);
+            if (rNorm <= target || !std::isfinite(rNorm)) break;
+            const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
+            const double beta = rzNew / rz;
+            rz = rzNew;
+            parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
+                for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
+            });
+        }
+        if (!single || st.failed || !std::isfinite(rNorm)) break;
+        rNorm = trueResidual(); // the check in double; a miss continues in double
+        if (it >= maxIterations) break;
     }
     st.iterations = it;
     st.residual = rNorm / rhsNorm;
@@ -413,14 +383,10 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
 SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
                                         VecX& y) {
     SolveStatus st;
-    const auto& rowA = A.matrix();
-    // The pattern is symmetric and sorted, so the column-major arrays of Â equal the row-major
-    // ones: copy the values, then filter the constrained block rows and columns.
-    if (mFilteredA.rows() != rowA.rows() || mFilteredA.nonZeros() != rowA.nonZeros()) {
-        mFilteredA = ColMatrix(rowA); // establishes the (identical) pattern once
-        mLdlt.reset();
-    }
-    std::memcpy(mFilteredA.valuePtr(), rowA.valuePtr(), sizeof(double) * rowA.nonZeros());
+    // The scalar matrix (its pattern built once), then the constrained block rows and columns
+    // filtered.
+    if (mFilteredA.rows() != 3 * A.size() || mFilteredA.nonZeros() != 9L * A.slotCount()) mLdlt.reset();
+    A.toScalar(mFilteredA);
     const bool constrained = !c.kind.empty() && c.any();
     if (constrained) {
         // Column-major over a symmetric pattern: column 3j+a lists rows; entry (r, col).

@@ -18,8 +18,13 @@
 
 namespace gale::solver {
 
+// Values in block CSR (BSR): slot k holds the 3×3 block (i, blockCols()[k]) of block row i
+// column-major at values()[9k .. 9k+8] — the layout the kernels of bsr_kernels.h and the
+// multigrid read directly, so the assembled matrix reaches them with one copy.
 class BlockMatrix {
 public:
+    using ScalarMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor>;
+
     // n block rows; `pairs` lists coupled vertices (i ≠ j, either order, repeats allowed). The
     // pattern is the diagonal plus both (i, j) and (j, i).
     void build(int n, const std::vector<std::pair<int, int>>& pairs);
@@ -28,25 +33,27 @@ public:
     // Slot of block (i, j), -1 when not in the pattern.
     int slot(int i, int j) const;
     int diagonalSlot(int i) const { return mDiagSlot[i]; }
-    int slotCount() const { return static_cast<int>(mSlotBase.size()); }
+    int slotCount() const { return static_cast<int>(mBlockCols.size()); }
+    // Slot of the transposed block: (j, i) for slot (i, j).
+    int mirrorSlot(int slot) const { return mMirror[slot]; }
 
     void setZero();
     // values(i, j) += scale * b
     void addBlock(int slot, const Mat3& b, double scale = 1.0) {
-        double* p = mA.valuePtr() + mSlotBase[slot];
-        const int s = mSlotStride[slot];
-        for (int a = 0; a < 3; ++a)
-            for (int c = 0; c < 3; ++c) p[a * s + c] += scale * b(a, c);
+        double* p = mVal.data() + 9 * static_cast<size_t>(slot);
+        const double* q = b.data(); // column-major, as stored
+        for (int k = 0; k < 9; ++k) p[k] += scale * q[k];
     }
     void addDiagonal(int slot, double value) {
-        double* p = mA.valuePtr() + mSlotBase[slot];
-        const int s = mSlotStride[slot];
+        double* p = mVal.data() + 9 * static_cast<size_t>(slot);
         p[0] += value;
-        p[s + 1] += value;
-        p[2 * s + 2] += value;
+        p[4] += value;
+        p[8] += value;
     }
-    Mat3 block(int slot) const;
-    void setBlock(int slot, const Mat3& b);
+    Mat3 block(int slot) const { return Eigen::Map<const Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)); }
+    void setBlock(int slot, const Mat3& b) { Eigen::Map<Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)) = b; }
+    // 9 × slotCount() values (+ kBsrPad zeros).
+    const double* values() const { return mVal.data(); }
 
     // y = A x (3n vectors), parallel over rows, deterministic.
     void multiply(const double* x, double* y) const;
@@ -55,15 +62,21 @@ public:
     // sorted; slot k is the k-th entry of blockCols().
     const std::vector<int>& blockRowStart() const { return mBlockRowStart; }
     const std::vector<int>& blockCols() const { return mBlockCols; }
+    BsrPattern pattern() const { return {mBlockRowStart.data(), mBlockCols.data(), mDiagSlot.data(), mN}; }
 
-    const Eigen::SparseMatrix<double, Eigen::RowMajor>& matrix() const { return mA; }
-    Eigen::SparseMatrix<double, Eigen::RowMajor>& matrix() { return mA; }
+    // The scalar (3n × 3n) matrix; `toScalar` reuses out's pattern when it already has it.
+    void toScalar(ScalarMatrix& out) const;
+    ScalarMatrix scalar() const {
+        ScalarMatrix m;
+        toScalar(m);
+        return m;
+    }
 
 private:
     int mN = 0;
-    Eigen::SparseMatrix<double, Eigen::RowMajor> mA;
+    std::vector<double> mVal;
     std::vector<int> mBlockRowStart, mBlockCols; // block CSR of the pattern
-    std::vector<int> mSlotBase, mSlotStride, mDiagSlot;
+    std::vector<int> mDiagSlot, mMirror;
 };
 
 // Per-vertex constraint of the Baraff–Witkin filter: Δv_i = S_i y_i + z_i with z_i the
@@ -94,6 +107,10 @@ struct SolveStatus {
 
 enum class LinearSolverKind { Pcg, Direct };
 
+// Multigrid PCG multiplies with a single-precision copy of the matrix at tolerances from this
+// one up (and checks the result in double; see FilteredSolver::solvePcgMultigrid).
+constexpr double kSinglePrecisionTolerance = 1e-5;
+
 // Solves (M + hD + h²K) Δv = b subject to the constraints, as the SPD filtered system
 //   (S A S + I − S) y = S (b − A z),   Δv = y + z
 // (Ascher & Boxerman 2003; Tamstorf, Jones, McCormick 2015), which is equivalent to
@@ -122,7 +139,7 @@ private:
     std::vector<double> mPartial;
     std::vector<int> mConstrained; // vertices with S ≠ I
     std::vector<Mat3> mPrecond;
-    using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor>;
+    using ColMatrix = BlockMatrix::ScalarMatrix;
     ColMatrix mFilteredA;
     std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix>> mLdlt;
 };

@@ -54,7 +54,7 @@ TEST_CASE("linear: PCG and LDLT solve the filtered system alike", "[linear]") {
     c.apply(r.data());
     CHECK(r.norm() < 1e-9 * b.norm());
     // Against a dense solve of the same filtered system (S A S + I − S) y = S (b − A z).
-    const Eigen::MatrixXd D = Eigen::MatrixXd(A.matrix());
+    const Eigen::MatrixXd D = Eigen::MatrixXd(A.scalar());
     Eigen::MatrixXd S = Eigen::MatrixXd::Identity(3 * n, 3 * n);
     for (int i = 0; i < n; ++i) S.block<3, 3>(3 * i, 3 * i) = c.filter(i);
     const VecX z = Eigen::Map<const VecX>(c.z.data(), 3 * n);

@@ -4,6 +4,7 @@
 // multigrid for cloth simulation", SIGGRAPH Asia 2015.
 #include "solver/multigrid.h"
 
+#include "solver/bsr_kernels.h"
 #include "solver/linear.h"
 
 #include <Eigen/Eigenvalues>
@@ -16,9 +17,9 @@ namespace gale::solver {
 
 namespace {
 
-using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-using BlockMap = Eigen::Map<RowMat3>;
-using ConstBlockMap = Eigen::Map<const RowMat3>;
+// Blocks are stored column-major, 9 values each (bsr_kernels.h).
+using BlockMap = Eigen::Map<Mat3>;
+using ConstBlockMap = Eigen::Map<const Mat3>;
 
 // The inverse of a 3×3 diagonal block; a scaled identity when it is singular.
 void invertBlock(const double* b, double* out) {
@@ -49,45 +50,26 @@ Mat3 filterOf(uint8_t kind, const double* normal) {
 // ---------------------------------------------------------------------------------------------
 // BsrMatrix
 
-// yi = Σ_k A_ik x_k over block row i: the three entries of row i of A x.
-static void blockRowProduct(const BsrMatrix& m, size_t i, const double* x, double* yi) {
-    double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-    for (int k = m.start[i]; k < m.start[i + 1]; ++k) {
-        const double* b = m.val.data() + 9 * static_cast<size_t>(k);
-        const double* xj = x + 3 * static_cast<size_t>(m.cols[k]);
-        const double a = xj[0], c = xj[1], d = xj[2];
-        y0 += b[0] * a + b[1] * c + b[2] * d;
-        y1 += b[3] * a + b[4] * c + b[5] * d;
-        y2 += b[6] * a + b[7] * c + b[8] * d;
-    }
-    yi[0] = y0;
-    yi[1] = y1;
-    yi[2] = y2;
-}
-
 void BsrMatrix::multiply(const double* x, double* y) const {
-    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) blockRowProduct(*this, i, x, y + 3 * i);
-    });
+    const BsrPattern p = pattern();
+    parallelChunks(static_cast<size_t>(n), 512,
+                   [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
 }
 
-double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial) const {
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single) const {
     const size_t n3 = 3 * static_cast<size_t>(n);
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     const size_t rowsPerChunk = kReduceChunk / 3;
+    const BsrPattern p = pattern();
     partial.assign(chunks, 0.0);
     parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
         for (size_t ch = c0; ch < c1; ++ch) {
             const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
+            const size_t i0 = ch * rowsPerChunk;
+            if (single) bsrMultiplyRows(p, single, x, y, i0, i1);
+            else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
             double s = 0.0;
-            for (size_t i = ch * rowsPerChunk; i < i1; ++i) {
-                blockRowProduct(*this, i, x, y + 3 * i);
-                const double y0 = y[3 * i], y1 = y[3 * i + 1], y2 = y[3 * i + 2];
-                // In entry order, as deterministicDot sums.
-                s += x[3 * i] * y0;
-                s += x[3 * i + 1] * y1;
-                s += x[3 * i + 2] * y2;
-            }
+            for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
             partial[ch] = s;
         }
     });
@@ -105,12 +87,12 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     a.n = A.size();
     a.start = A.blockRowStart();
     a.cols = A.blockCols();
-    a.val.assign(9 * a.cols.size(), 0.0);
+    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
     a.diag.resize(a.n);
     a.mirror.resize(a.cols.size());
     for (int i = 0; i < a.n; ++i) {
         a.diag[i] = A.diagonalSlot(i);
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) a.mirror[k] = A.slot(a.cols[k], i);
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) a.mirror[k] = A.mirrorSlot(k);
     }
     mPatternRows = A.size();
     mPatternSlots = A.slotCount();
@@ -186,7 +168,7 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
         c.diag[I] = slotOf(I, I);
         for (int k = c.start[I]; k < c.start[I + 1]; ++k) c.mirror[k] = slotOf(c.cols[k], I);
     }
-    c.val.assign(9 * c.cols.size(), 0.0);
+    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
     fine.coarseSlot.resize(a.cols.size());
     for (int i = 0; i < n; ++i)
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
@@ -239,13 +221,9 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     // Level 0: Â = S A S + I − S.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
+    std::copy(A.values(), A.values() + a.val.size(), a.val.begin()); // the same layout, pad included
     bool finite = true;
-    for (int k = 0; k < a.blocks(); ++k) {
-        const Mat3 b = A.block(k);
-        BlockMap(a.val.data() + 9 * static_cast<size_t>(k)) = b;
-    }
-    for (double v : a.val)
-        if (!std::isfinite(v)) finite = false;
+    for (double v : a.val) finite = finite && std::isfinite(v);
     if (!finite) return false;
     mKind.clear();
     if (!constrained.empty()) {
@@ -285,7 +263,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     for (Level& L : mLevels) {
         L.lowVal.resize(L.a.val.size());
         for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
-        L.dinv.resize(9 * static_cast<size_t>(L.a.n));
+        L.dinv.assign(9 * static_cast<size_t>(L.a.n) + kBsrPad, 0.0);
         // The inverse of the single-precision diagonal, so that every sweep reads one matrix
         // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
         for (int i = 0; i < L.a.n; ++i) {
@@ -322,43 +300,17 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     double* x = L.x.data();
     const double* r = L.r.data();
     if (mSettings.gaussSeidel) {
-        // x_i += D_i⁻¹ (r_i − Σ_j A_ij x_j), rows in order (forward) or reverse (backward).
-        // From zero, a forward sweep reads only the rows before i (the rest are still zero).
-        const int* start = a.start.data();
-        const int* cols = a.cols.data();
-        const int* diag = a.diag.data();
-        const float* val = L.lowVal.data();
-        const double* dinv = L.dinv.data();
-        for (int s = 0; s < n; ++s) {
-            const int i = forward ? s : n - 1 - s;
-            double y0 = r[3 * i], y1 = r[3 * i + 1], y2 = r[3 * i + 2];
-            const int end = fromZero && forward ? diag[i] : start[i + 1];
-            for (int k = start[i]; k < end; ++k) {
-                const float* b = val + 9 * static_cast<size_t>(k);
-                const double* xj = x + 3 * static_cast<size_t>(cols[k]);
-                const double p = xj[0], q = xj[1], u = xj[2];
-                y0 -= b[0] * p + b[1] * q + b[2] * u;
-                y1 -= b[3] * p + b[4] * q + b[5] * u;
-                y2 -= b[6] * p + b[7] * q + b[8] * u;
-            }
-            const double* d = dinv + 9 * static_cast<size_t>(i);
-            const double x0 = x[3 * i] + d[0] * y0 + d[1] * y1 + d[2] * y2;
-            const double x1 = x[3 * i + 1] + d[3] * y0 + d[4] * y1 + d[5] * y2;
-            const double x2 = x[3 * i + 2] + d[6] * y0 + d[7] * y1 + d[8] * y2;
-            x[3 * i] = x0, x[3 * i + 1] = x1, x[3 * i + 2] = x2;
-            if (!residual) continue;
-            // t_j −= A_ji x_i = A_ijᵀ x_i for the earlier rows j (A symmetric), from the blocks
-            // just read: when the sweep ends, t = r − A x with no second pass over A.
-            double* t = L.t.data();
-            t[3 * i] = t[3 * i + 1] = t[3 * i + 2] = 0.0;
-            for (int k = start[i]; k < end; ++k) {
-                const float* b = val + 9 * static_cast<size_t>(k);
-                double* tj = t + 3 * static_cast<size_t>(cols[k]);
-                tj[0] -= b[0] * x0 + b[3] * x1 + b[6] * x2;
-                tj[1] -= b[1] * x0 + b[4] * x1 + b[7] * x2;
-                tj[2] -= b[2] * x0 + b[5] * x1 + b[8] * x2;
-            }
-        }
+        GaussSeidelSweep g;
+        g.pattern = a.pattern();
+        g.val = L.lowVal.data();
+        g.mirror = a.mirror.data();
+        g.dinv = L.dinv.data();
+        g.r = r;
+        g.x = x;
+        g.t = residual ? L.t.data() : nullptr;
+        g.forward = forward;
+        g.fromZero = fromZero && forward;
+        gaussSeidelSweep(g);
         return;
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).

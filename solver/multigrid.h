@@ -3,6 +3,7 @@
 // block-CSR (BSR) copy of the filtered matrix Â that the multigrid CG multiplies with.
 #pragma once
 
+#include "solver/bsr_kernels.h"
 #include "solver/types.h"
 
 #include <Eigen/Cholesky>
@@ -19,18 +20,21 @@ struct Constraints;
 enum class Preconditioner { BlockJacobi, Multigrid };
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
-// row-major, column cols[k]; columns sorted, the diagonal present.
+// column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
+// zeros (bsr_kernels.h).
 struct BsrMatrix {
     int n = 0;
     std::vector<int> start, cols, diag, mirror; // mirror[k]: slot of the transposed block
     std::vector<double> val;
 
     int blocks() const { return static_cast<int>(cols.size()); }
+    BsrPattern pattern() const { return {start.data(), cols.data(), diag.data(), n}; }
     // y = M x, parallel over rows (deterministic: each row is summed in column order).
     void multiply(const double* x, double* y) const;
     // y = M x and returns xᵀy, summed in chunks of kReduceChunk entries like deterministicDot
     // (same bits; one pass over x and y instead of two). `partial` is scratch.
-    double multiplyDot(const double* x, double* y, std::vector<double>& partial) const;
+    // With `single` (these values in float), the product reads those instead of val.
+    double multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single = nullptr) const;
 };
 
 // Plain (unsmoothed) aggregation AMG with a constraint-filtered tentative prolongator:
@@ -66,8 +70,11 @@ public:
     double apply(const double* r, double* z);
     // y = Â x with the level-0 copy.
     void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
-    // y = Â x and returns xᵀÂx (deterministicDot's summation order).
-    double multiplyDot(const double* x, double* y) { return mLevels[0].a.multiplyDot(x, y, mPartial); }
+    // y = Â x and returns xᵀÂx (deterministicDot's summation order); `single`: with the
+    // single-precision copy of Â (half the memory traffic; see FilteredSolver::solvePcgMultigrid).
+    double multiplyDot(const double* x, double* y, bool single) {
+        return mLevels[0].a.multiplyDot(x, y, mPartial, single ? mLevels[0].lowVal.data() : nullptr);
+    }
 
     int levelCount() const { return static_cast<int>(mLevels.size()); }
     int rows(int level) const { return mLevels[level].a.n; }

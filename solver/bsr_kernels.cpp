@@ -1,0 +1,93 @@
+// The block kernels on scalar doubles, and the run-time choice of the AVX2 + FMA ones
+// (bsr_kernels_avx2.cpp) on a CPU that has them.
+#include "solver/bsr_kernels.h"
+
+#include "solver/bsr_kernels_body.h"
+
+#include <atomic>
+
+namespace gale::solver {
+
+#if defined(GALE_HAVE_AVX2_KERNELS)
+// bsr_kernels_avx2.cpp
+void bsrMultiplyRowsAvx2(const BsrPattern& m, const double* val, const double* x, double* y, std::size_t i0,
+                         std::size_t i1);
+void bsrMultiplyRowsAvx2(const BsrPattern& m, const float* val, const double* x, double* y, std::size_t i0,
+                         std::size_t i1);
+void gaussSeidelSweepAvx2(const GaussSeidelSweep& g);
+#endif
+
+namespace {
+
+struct Vec3d {
+    double a, b, c;
+};
+
+// The same arithmetic as the wide kernels, one lane at a time.
+struct ScalarOps {
+    using V = Vec3d;
+    static V zero() { return {0.0, 0.0, 0.0}; }
+    static V load3(const double* p) { return {p[0], p[1], p[2]}; }
+    static void store3(double* p, V v) {
+        p[0] = v.a;
+        p[1] = v.b;
+        p[2] = v.c;
+    }
+    static V add(V u, V v) { return {u.a + v.a, u.b + v.b, u.c + v.c}; }
+    static V sub(V u, V v) { return {u.a - v.a, u.b - v.b, u.c - v.c}; }
+    template <class T>
+    static V block(const T* m, const double* x) {
+        const double x0 = x[0], x1 = x[1], x2 = x[2];
+        return {double(m[0]) * x0 + double(m[3]) * x1 + double(m[6]) * x2,
+                double(m[1]) * x0 + double(m[4]) * x1 + double(m[7]) * x2,
+                double(m[2]) * x0 + double(m[5]) * x1 + double(m[8]) * x2};
+    }
+    static V blockTimes(const double* m, V y) {
+        const double v[3] = {y.a, y.b, y.c};
+        return block(m, v);
+    }
+};
+
+bool cpuHasAvx2Fma() {
+#if defined(GALE_HAVE_AVX2_KERNELS)
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+    return false;
+#endif
+}
+
+std::atomic<bool>& wideSwitch() {
+    static std::atomic<bool> on{cpuHasAvx2Fma()};
+    return on;
+}
+
+} // namespace
+
+bool wideKernels() { return wideSwitch().load(std::memory_order_relaxed); }
+void setWideKernels(bool on) { wideSwitch().store(on && cpuHasAvx2Fma(), std::memory_order_relaxed); }
+
+void bsrMultiplyRows(const BsrPattern& m, const double* val, const double* x, double* y, std::size_t i0,
+                     std::size_t i1) {
+#if defined(GALE_HAVE_AVX2_KERNELS)
+    if (wideKernels()) return bsrMultiplyRowsAvx2(m, val, x, y, i0, i1);
+#endif
+    kernels::multiplyRows<ScalarOps>(m, val, x, y, i0, i1);
+}
+
+void bsrMultiplyRows(const BsrPattern& m, const float* val, const double* x, double* y, std::size_t i0,
+                     std::size_t i1) {
+#if defined(GALE_HAVE_AVX2_KERNELS)
+    if (wideKernels()) return bsrMultiplyRowsAvx2(m, val, x, y, i0, i1);
+#endif
+    kernels::multiplyRows<ScalarOps>(m, val, x, y, i0, i1);
+}
+
+void gaussSeidelSweep(const GaussSeidelSweep& g) {
+#if defined(GALE_HAVE_AVX2_KERNELS)
+    if (wideKernels()) return gaussSeidelSweepAvx2(g);
+#endif
+    kernels::sweepAny<ScalarOps>(g);
+}
+
+} // namespace gale::solver
