@@ -221,10 +221,23 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     // Level 0: Â = S A S + I − S.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
-    std::copy(A.values(), A.values() + a.val.size(), a.val.begin()); // the same layout, pad included
+    // One pass over A (the same layout, pad included): the double copy, its single-precision
+    // twin for the smoother and the CG products, and the finiteness check.
+    std::vector<float>& low = mLevels[0].lowVal;
+    low.resize(a.val.size());
+    const double* src = A.values();
     bool finite = true;
-    for (double v : a.val) finite = finite && std::isfinite(v);
+    for (size_t k = 0; k < a.val.size(); ++k) {
+        const double v = src[k];
+        a.val[k] = v;
+        low[k] = static_cast<float>(v);
+        finite &= std::isfinite(v);
+    }
     if (!finite) return false;
+    auto lower = [&](int k) {
+        for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
+            low[q] = static_cast<float>(a.val[q]);
+    };
     mKind.clear();
     if (!constrained.empty()) {
         mKind.assign(n, 0);
@@ -240,8 +253,11 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
                 row = (S * row).eval();
                 BlockMap col(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]));
                 col = (col * S).eval();
+                lower(k);
+                lower(a.mirror[k]);
             }
             BlockMap(a.val.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+            lower(a.diag[i]);
         }
     }
     // Coarse levels: aggregate on first sight of the pattern, then sum.
@@ -261,8 +277,10 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         coarsen(l);
     }
     for (Level& L : mLevels) {
-        L.lowVal.resize(L.a.val.size());
-        for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        if (&L != &mLevels[0]) { // level 0's copy was made above
+            L.lowVal.resize(L.a.val.size());
+            for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        }
         L.dinv.assign(9 * static_cast<size_t>(L.a.n) + kBsrPad, 0.0);
         // The inverse of the single-precision diagonal, so that every sweep reads one matrix
         // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
