@@ -156,12 +156,17 @@ SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, co
     mConstrained.clear();
     for (size_t i = 0; i < c.kind.size(); ++i)
         if (c.kind[i]) mConstrained.push_back(static_cast<int>(i));
-    // rhs = S (b − A z); initial y = S dv.
+    // rhs = S (b − A z); initial y = S dv. z is zero but at the constrained vertices, so A z
+    // is a sum over their block columns (A_ij = (A_ji)ᵀ: the mirror of row j's blocks).
     VecX z = VecX::Zero(n3);
     if (!c.z.empty()) z = Eigen::Map<const VecX>(c.z.data(), n3);
-    mTmp.resize(n3);
-    A.multiply(z.data(), mTmp.data());
-    VecX rhs = b - mTmp;
+    VecX rhs = b;
+    for (int j : mConstrained) {
+        const Vec3 zj = z.segment<3>(3 * j);
+        if (zj.isZero(0.0)) continue;
+        for (int k = A.blockRowStart()[j]; k < A.blockRowStart()[j + 1]; ++k)
+            rhs.segment<3>(3 * A.blockCols()[k]) -= A.block(A.mirrorSlot(k)) * zj;
+    }
     c.apply(rhs.data());
     VecX y = dv;
     c.apply(y.data());
@@ -291,6 +296,51 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
     return st;
 }
 
+// Multigrid-preconditioned CG iterations on Â y = rhs from the residual in mR (‖mR‖ = rNorm)
+// until ‖r‖ ≤ target or `it` reaches maxIterations; returns ‖r‖ (of the products used).
+double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
+                                   SolveStatus& st) {
+    if (rNorm <= target || !std::isfinite(rNorm)) return rNorm;
+    const size_t n3 = static_cast<size_t>(y.size());
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    mPartial.assign(chunks, 0.0);
+    double rz = mMultigrid.apply(mR.data(), mZ.data());
+    mP = mZ;
+    while (it < maxIterations) {
+        const double pq = mMultigrid.multiplyDot(mP.data(), mQ.data(), single); // q = Â p, pᵀq
+        if (!(pq > 0.0) || !std::isfinite(pq)) {
+            st.failed = !std::isfinite(pq);
+            break;
+        }
+        const double alpha = rz / pq;
+        // y += α p; r −= α q; partial sums of r·r.
+        parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+            for (size_t ch = c0; ch < c1; ++ch) {
+                const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
+                double rr = 0.0;
+                for (size_t k = b; k < e; ++k) {
+                    y[k] += alpha * mP[k];
+                    mR[k] -= alpha * mQ[k];
+                    rr += mR[k] * mR[k];
+                }
+                mPartial[ch] = rr;
+            }
+        });
+        double rr = 0.0;
+        for (size_t ch = 0; ch < chunks; ++ch) rr += mPartial[ch];
+        ++it;
+        rNorm = std::sqrt(rr);
+        if (rNorm <= target || !std::isfinite(rNorm)) break;
+        const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
+        const double beta = rzNew / rz;
+        rz = rzNew;
+        parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
+            for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
+        });
+    }
+    return rNorm;
+}
+
 // PCG on Â (its BSR copy in the multigrid's level 0) with one symmetric V-cycle as the
 // preconditioner; reductions in fixed chunks as above.
 //
@@ -323,55 +373,21 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     mP.resize(n3);
     mQ.resize(n3);
     const double target = tolerance * rhsNorm;
-    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
-    mPartial.assign(chunks, 0.0);
-    // r = rhs − Â y in double; returns ‖r‖.
-    auto trueResidual = [&] {
-        mMultigrid.multiply(y.data(), mQ.data());
+    // r = rhs − Â y (the products in double unless `single`); returns ‖r‖.
+    auto residual = [&](bool single) {
+        if (single) mMultigrid.multiplyDot(y.data(), mQ.data(), true);
+        else mMultigrid.multiply(y.data(), mQ.data());
         mR = rhs - mQ;
         return std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
     };
-    double rNorm = trueResidual();
+    const bool single = tolerance >= kSinglePrecisionTolerance;
+    double rNorm = residual(single);
     int it = 0;
-    for (bool single = tolerance >= kSinglePrecisionTolerance;; single = false) {
-        if (rNorm <= target || !std::isfinite(rNorm)) break;
-        double rz = mMultigrid.apply(mR.data(), mZ.data());
-        mP = mZ;
-        while (it < maxIterations) {
-            const double pq = mMultigrid.multiplyDot(mP.data(), mQ.data(), single); // q = Â p, pᵀq
-            if (!(pq > 0.0) || !std::isfinite(pq)) {
-                st.failed = !std::isfinite(pq);
-                break;
-            }
-            const double alpha = rz / pq;
-            // y += α p; r −= α q; partial sums of r·r.
-            parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
-                for (size_t ch = c0; ch < c1; ++ch) {
-                    const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
-                    double rr = 0.0;
-                    for (size_t k = b; k < e; ++k) {
-                        y[k] += alpha * mP[k];
-                        mR[k] -= alpha * mQ[k];
-                        rr += mR[k] * mR[k];
-                    }
-                    mPartial[ch] = rr;
-                }
-            });
-            double rr = 0.0;
-            for (size_t ch = 0; ch < chunks; ++ch) rr += mPartial[ch];
-            ++it;
-            rNorm = std::sqrt(rr);
-            if (rNorm <= target || !std::isfinite(rNorm)) break;
-            const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
-            const double beta = rzNew / rz;
-            rz = rzNew;
-            parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
-                for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];
-            });
-        }
-        if (!single || st.failed || !std::isfinite(rNorm)) break;
-        rNorm = trueResidual(); // the check in double; a miss continues in double
-        if (it >= maxIterations) break;
+    rNorm = multigridCg(y, rNorm, target, single, maxIterations, it, st);
+    if (single && !st.failed && std::isfinite(rNorm)) {
+        rNorm = residual(false); // the check in double; a miss continues in double
+        if (!(rNorm <= target) && it < maxIterations)
+            rNorm = multigridCg(y, rNorm, target, false, maxIterations, it, st);
     }
     st.iterations = it;
     st.residual = rNorm / rhsNorm;

@@ -130,12 +130,14 @@ private:
                          double tolerance, int maxIterations);
     SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
                                   double tolerance, int maxIterations);
+    double multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
+                       SolveStatus& st);
     SolveStatus solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y);
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
     Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
     BlockMultigrid mMultigrid;
-    VecX mTmp, mTmp2, mR, mZ, mP, mQ;
+    VecX mTmp2, mR, mZ, mP, mQ;
     std::vector<double> mPartial;
     std::vector<int> mConstrained; // vertices with S ≠ I
     std::vector<Mat3> mPrecond;
