@@ -25,13 +25,16 @@ bool orientedNormal(const Vec3& vRel, const Vec3& areaNormal, Vec3& n, double& a
     if (!(area > 0.0) || !std::isfinite(area)) return false;
     n = areaNormal / area;
     const double s = n.dot(vRel);
-    // Exactly edge-on the side is ambiguous: pick it from the normal alone (its largest
-    // component positive), so that both windings of a triangle feel the same force.
-    int big = 0;
-    for (int k = 1; k < 3; ++k)
-        if (std::abs(n[k]) > std::abs(n[big])) big = k;
-    if (s < 0.0 || (s == 0.0 && n[big] < 0.0))
+    if (s < 0.0) {
         n = -n;
+    } else if (s == 0.0) {
+        // Exactly edge-on the side is ambiguous: pick it from the normal alone (its largest
+        // component positive), so that both windings of a triangle feel the same force.
+        int big = 0;
+        for (int k = 1; k < 3; ++k)
+            if (std::abs(n[k]) > std::abs(n[big])) big = k;
+        if (n[big] < 0.0) n = -n;
+    }
     return true;
 }
 
@@ -41,27 +44,58 @@ Vec3 anyPerpendicular(const Vec3& n) {
     return (a - a.dot(n) * n).normalized();
 }
 
+// The unit e ⟂ n in the plane of n and v, v = (v·n) n + q e with q ≥ 0 (any perpendicular
+// and q = 0 when v is along n).
+Vec3 inPlaneDirection(const Vec3& n, const Vec3& v, double vNorm, double& q) {
+    const Vec3 e = v - v.dot(n) * n;
+    q = e.norm();
+    if (q > 1e-12 * (vNorm + 1e-300) && q > 0.0) return e / q;
+    q = 0.0;
+    return anyPerpendicular(n);
+}
+
+// The nearest PSD matrix to the symmetric S = [n e] M [n e]ᵀ + c b bᵀ (n, e, b orthonormal),
+// M = [[a11, a12], [a12, a22]]: each part projected on its own.
+// Eigenvalues of M: l1,2 = m ± r, m = (a11 + a22)/2, r = √(((a11 − a22)/2)² + a12²).
+// Both ≥ 0: M is its own projection. Both ≤ 0: it projects to 0. Otherwise l1 > 0 > l2 and the
+// projection is l1 u1u1ᵀ with the eigenprojector u1u1ᵀ = (M − l2 I₂)/(l1 − l2), l1 − l2 = 2r > 0
+// (no eigenvector angle needed; exact for a12 = 0 and equal eigenvalues alike).
+// With M⁺ = [[p11, p12], [p12, p22]] and b bᵀ = I − n nᵀ − e eᵀ:
+//   out = max(c, 0) I + (p11 − c⁺) n nᵀ + p12 (n eᵀ + e nᵀ) + (p22 − c⁺) e eᵀ  (exactly symmetric).
+// A NaN entry propagates (a non-finite state must stay visible).
+Mat3 projectPlane(double a11, double a12, double a22, double c, const Vec3& n, const Vec3& e) {
+    const double mean = 0.5 * (a11 + a22), half = 0.5 * (a11 - a22);
+    const double rad = std::sqrt(half * half + a12 * a12);
+    const double l1 = mean + rad, l2 = mean - rad;
+    if (l1 <= 0.0) {
+        a11 = a12 = a22 = 0.0;
+    } else if (l2 < 0.0) {
+        const double w = l1 / (2.0 * rad);
+        a11 = w * (a11 - l2);
+        a22 = w * (a22 - l2);
+        a12 = w * a12;
+    }
+    const double cp = c <= 0.0 ? 0.0 : c;
+    const double d11 = a11 - cp, d22 = a22 - cp;
+    Mat3 out;
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j) {
+            const double x = d11 * (n[i] * n[j]) + a12 * (n[i] * e[j] + e[i] * n[j]) + d22 * (e[i] * e[j]);
+            out(i, j) = out(j, i) = i == j ? x + cp : x;
+        }
+    return out;
+}
+
 } // namespace
 
 Mat3 projectPsdInPlane(const Mat3& j, const Vec3& n, const Vec3& v) {
     const Mat3 s = 0.5 * (j + j.transpose());
-    Vec3 e = v - v.dot(n) * n;
-    const double en = e.norm();
-    e = en > 1e-12 * (v.norm() + 1e-300) && en > 0.0 ? Vec3(e / en) : anyPerpendicular(n);
+    double q;
+    const Vec3 e = inPlaneDirection(n, v, v.norm(), q);
     const Vec3 b = n.cross(e);
     // In the orthonormal basis (n, e, b): a 2×2 block on (n, e) and c on b; no coupling of b.
-    const double a11 = n.dot(s * n), a12 = n.dot(s * e), a22 = e.dot(s * e);
-    const double c = b.dot(s * b);
-    const double mean = 0.5 * (a11 + a22), half = 0.5 * (a11 - a22);
-    const double rad = std::sqrt(half * half + a12 * a12);
-    const double l1 = mean + rad, l2 = mean - rad;
-    // Eigenvector of l1 in the (n, e) plane: (cos φ, sin φ) with tan 2φ = 2 a12 / (a11 − a22).
-    const double phi = 0.5 * std::atan2(2.0 * a12, a11 - a22);
-    const Vec3 u1 = std::cos(phi) * n + std::sin(phi) * e;
-    const Vec3 u2 = -std::sin(phi) * n + std::cos(phi) * e;
-    Mat3 out = std::max(l1, 0.0) * u1 * u1.transpose() + std::max(l2, 0.0) * u2 * u2.transpose() +
-               std::max(c, 0.0) * b * b.transpose();
-    return out;
+    const Vec3 se = s * e;
+    return projectPlane(n.dot(s * n), n.dot(se), e.dot(se), b.dot(s * b), n, e);
 }
 
 Mat3 aeroTriangleExactJacobian(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
@@ -111,10 +145,28 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
         out.damping = k * s * (iso * Mat3::Identity() + (cd + cl) * n * n.transpose());
         break;
     }
-    case AeroJacobian::Projected:
-        out.damping = projectPsdInPlane(aeroTriangleExactJacobian(vRel, areaNormal, rho, cl, cd, model),
-                                        n, vRel);
+    case AeroJacobian::Projected: {
+        // projectPsdInPlane(aeroTriangleExactJacobian(..), n, v) with the symmetric part of the
+        // exact Jacobian written out in the basis (n, e, b), v = s n + q e, r² = s² + q²:
+        //   frozen:      M = k [[2 C_D s, (C_D + C_L) q/2], [·, (C_D − C_L) s]],  c = k (C_D − C_L) s
+        //   smooth-lift: M = k [[2 C_D s + C_L q⁴/r³, C_D q/2 + C_L s q (s² − q²)/(2r³)],
+        //                       [·, C_D s − C_L s⁴/r³]],                    c = k (C_D s − C_L s²/r)
+        // (smooth-lift in the bounded ratios σ = s/r, κ = q/r: q⁴/r³ = q κ³, s⁴/r³ = s σ³, ...).
+        double q;
+        const double r = std::sqrt(r2);
+        const Vec3 e = inPlaneDirection(n, vRel, r, q);
+        if (model == AeroModel::Frozen) {
+            const double iso = k * (cd - cl) * s;
+            out.damping = projectPlane(2.0 * k * cd * s, 0.5 * k * (cd + cl) * q, iso, iso, n, e);
+        } else {
+            const double sig = s / r, kap = q / r;
+            out.damping = projectPlane(k * (2.0 * cd * s + cl * q * kap * kap * kap),
+                                       k * (0.5 * cd * q + 0.5 * cl * s * kap * (sig * sig - kap * kap)),
+                                       k * (cd * s - cl * s * sig * sig * sig), k * (cd * s - cl * s * sig),
+                                       n, e);
+        }
         break;
+    }
     }
     return out;
 }

@@ -182,3 +182,28 @@ TEST_CASE("aero: hair cross-flow drag and its Jacobian", "[aero][hair]") {
     }
     CHECK(aeroSegment(Vec3::Zero(), t, L, d, kRho, cn, ct).force == Vec3::Zero());
 }
+
+TEST_CASE("aero: in-plane PSD projection — diagonal, equal-eigenvalue and v ∥ n cases", "[aero]") {
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int k = 0; k < 400; ++k) {
+        const Vec3 n = Vec3(u(rng), u(rng), u(rng)).normalized();
+        Vec3 v = 5.0 * Vec3(u(rng), u(rng), u(rng));
+        if (k % 4 == 1) v = 3.0 * n; // v along n: any perpendicular
+        Vec3 e = v - v.dot(n) * n;
+        e = e.norm() > 1e-9 ? Vec3(e.normalized()) : Vec3(n.unitOrthogonal());
+        const Vec3 b = n.cross(e);
+        // j = c I + terms in span{n, e}, with a diagonal (a12 = 0) or isotropic in-plane block
+        // in some cases, of either sign.
+        const bool along = k % 4 == 1; // then j = c I + (terms in span{n}) only
+        const double c = u(rng), a11 = u(rng);
+        const double a22 = along ? c : k % 3 == 0 ? a11 : u(rng);
+        const double a12 = along || k % 5 == 0 ? 0.0 : u(rng), skew = along ? 0.0 : u(rng);
+        const Mat3 j = c * b * b.transpose() + a11 * n * n.transpose() + a22 * e * e.transpose() +
+                       (a12 + skew) * n * e.transpose() + (a12 - skew) * e * n.transpose();
+        const Mat3 p = projectPsdInPlane(j, n, v);
+        CHECK(p.allFinite());
+        CHECK((p - p.transpose()).norm() <= 1e-14 * (1 + p.norm()));
+        CHECK((p - projectByEigen(j)).norm() <= 1e-12 * (1 + j.norm()));
+    }
+}

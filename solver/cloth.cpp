@@ -6,12 +6,40 @@
 // matrix of the triangle contributes D/9 to each of its 9 corner blocks.
 #include "solver/cloth.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gale::solver {
 
 namespace {
 VecX flatten(const std::vector<double>& p) { return Eigen::Map<const VecX>(p.data(), p.size()); }
+
+// Adds a triangle's nine blocks (a, b) = cK·K_ab + D9 to A: K from the membrane factors m (null:
+// no membrane), K_ab = a_a a_b S_u + b_a b_b S_v + c s_a s_bᵀ (elastic.h); D9 = (h/9)·D is
+// symmetric. Only the shear term differs between (a, b) and (b, a) = (a, b)ᵀ.
+void addTriangleBlocks(BlockMatrix& A, const int slot[9], const MembraneFactors* m, double cK,
+                       const Mat3& D9) {
+    if (!m) {
+        for (int k = 0; k < 9; ++k) A.addBlock(slot[k], D9);
+        return;
+    }
+    for (int a = 0; a < 3; ++a) {
+        const Vec3 sa = (cK * m->shear) * m->s[a];
+        for (int b = a; b < 3; ++b) {
+            const double cu = cK * m->a[a] * m->a[b], cv = cK * m->b[a] * m->b[b];
+            const Vec3& sb = m->s[b];
+            Mat3 kab, kba;
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r) {
+                    const double sym = cu * m->Su(r, c) + cv * m->Sv(r, c) + D9(r, c);
+                    kab(r, c) = sym + sa[r] * sb[c];
+                    kba(r, c) = sym + sb[r] * sa[c];
+                }
+            A.addBlock(slot[3 * a + b], kab);
+            if (b != a) A.addBlock(slot[3 * b + a], kba);
+        }
+    }
+}
 } // namespace
 
 Cloth::Cloth(std::string name, TriMesh mesh, ClothMaterial material, const VecX* start)
@@ -59,11 +87,23 @@ Cloth::Cloth(std::string name, TriMesh mesh, ClothMaterial material, const VecX*
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b) mTriSlots[e][3 * a + b] = matrix().slot(t[a], t[b]);
     }
-    mHingeSlots.resize(mHinges.size());
-    for (size_t h = 0; h < mHinges.size(); ++h)
+    // The bending Hessian is constant up to k_b: per matrix slot (i, j), the sum over hinges of
+    // scale·k_a·k_b (a, b the hinge corners at i, j), so a substep adds cK·k_b·coef·I per slot.
+    std::vector<int> bendIndex(matrix().slotCount(), -1);
+    for (size_t h = 0; h < mHinges.size(); ++h) {
+        const HingeRest& r = mHingeRest[h];
+        if (!(r.scale > 0.0)) continue;
         for (int a = 0; a < 4; ++a)
-            for (int b = 0; b < 4; ++b)
-                mHingeSlots[h][4 * a + b] = matrix().slot(mHinges[h].v[a], mHinges[h].v[b]);
+            for (int b = 0; b < 4; ++b) {
+                const int slot = matrix().slot(mHinges[h].v[a], mHinges[h].v[b]);
+                if (bendIndex[slot] < 0) {
+                    bendIndex[slot] = static_cast<int>(mBendSlots.size());
+                    mBendSlots.push_back(slot);
+                    mBendCoef.push_back(0.0);
+                }
+                mBendCoef[bendIndex[slot]] += r.scale * r.k[a] * r.k[b];
+            }
+    }
     if (start && start->size() == mX.size()) mX = *start;
 }
 
@@ -87,28 +127,65 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     BlockMatrix* A = out.A;
     const size_t nt = mMesh.triangles.size();
 
-    // Membrane (stretch + shear) with Rayleigh damping f = −βKv.
-    TriangleElastic te;
+    // Aerodynamics only when the body feels wind with a nonzero coefficient; its damping
+    // matrix only for an implicit Jacobian.
+    const double cl0 = in.wind ? mMat.lift.at(t) : 0.0, cd0 = in.wind ? mMat.drag.at(t) : 0.0;
+    const bool aero = in.wind && !(cl0 == 0.0 && cd0 == 0.0);
+    const bool aeroMatrix = aero && A && in.aeroJacobian != AeroJacobian::None;
+    const bool paintL = !mTriLift.empty(), paintD = !mTriDrag.empty();
+
+    // Per triangle: membrane (stretch + shear) with Rayleigh damping f = −βKv, and the
+    // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
+    //   cK·K_ab + (h/9)·D.
+    MembraneFactors m;
+    const Mat3 zero = Mat3::Zero();
+    double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
+    int clamped = 0;
     for (size_t e = 0; e < nt; ++e) {
-        const MembraneRest& rest = mMembrane[e];
-        if (!(rest.area > 0.0)) continue;
         const auto& tri = mMesh.triangles[e];
         const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
-        membraneForces(rest, p, ks, ksh, te);
-        out.elasticEnergy += te.energy;
         const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
-        for (int a = 0; a < 3; ++a) {
-            const Vec3 kva = te.K[a][0] * vel[0] + te.K[a][1] * vel[1] + te.K[a][2] * vel[2];
-            f.segment<3>(3 * tri[a]) += te.f[a] - beta * kva;
-            if (kv) kv->segment<3>(3 * tri[a]) += kva;
+        Vec3 f3 = Vec3::Zero(); // F/3 per corner
+        Mat3 hD9;               // (h/9)·D
+        bool withD = false;
+        if (aero) {
+            const Vec3 areaNormal = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]);
+            const Vec3 wind =
+                (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) / 3.0;
+            const Vec3 u = (vel[0] + vel[1] + vel[2]) / 3.0;
+            const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
+            const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
+            const AeroResult r =
+                aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd, mMat.aeroModel, in.aeroJacobian);
+            clamped += r.clamped ? 1 : 0;
+            f3 = r.force / 3.0;
+            if (aeroMatrix) {
+                hD9 = (h / 9.0) * r.damping;
+                withD = true;
+            }
         }
-        if (A)
-            for (int a = 0; a < 3; ++a)
-                for (int b = 0; b < 3; ++b) A->addBlock(mTriSlots[e][3 * a + b], te.K[a][b], cK);
+        const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
+        if (membrane) {
+            energy += m.energy;
+            // (K v)_a = a_a S_u ẇ_u + b_a S_v ẇ_v + c (Σ_j s_j·v_j) s_a (elastic.h).
+            const Vec3 Swu = m.Su * (m.a[0] * vel[0] + m.a[1] * vel[1] + m.a[2] * vel[2]);
+            const Vec3 Swv = m.Sv * (m.b[0] * vel[0] + m.b[1] * vel[1] + m.b[2] * vel[2]);
+            const double sv = m.shear * (m.s[0].dot(vel[0]) + m.s[1].dot(vel[1]) + m.s[2].dot(vel[2]));
+            for (int a = 0; a < 3; ++a) {
+                const Vec3 kva = m.a[a] * Swu + m.b[a] * Swv + sv * m.s[a];
+                f.segment<3>(3 * tri[a]) += m.f[a] - beta * kva + f3;
+                if (kv) kv->segment<3>(3 * tri[a]) += kva;
+            }
+        } else if (aero) {
+            for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
+        }
+        if (A && (membrane || withD))
+            addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK, withD ? hD9 : zero);
     }
+    out.clamped += clamped;
 
-    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge.
-    if (kb != 0.0)
+    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale.
+    if (kb != 0.0) {
         for (size_t hi = 0; hi < mHinges.size(); ++hi) {
             const HingeRest& r = mHingeRest[hi];
             if (!(r.scale > 0.0)) continue;
@@ -119,37 +196,20 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                 s += r.k[a] * vec3At(in.x, v[a]);
                 sv += r.k[a] * vec3At(in.v, v[a]);
             }
-            out.elasticEnergy += 0.5 * c * s.squaredNorm();
+            energy += 0.5 * c * s.squaredNorm();
+            // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.
+            const Vec3 fs = c * (s + beta * sv), fv = c * sv;
             for (int a = 0; a < 4; ++a) {
-                f.segment<3>(3 * v[a]) -= c * r.k[a] * (s + beta * sv);
-                if (kv) kv->segment<3>(3 * v[a]) += c * r.k[a] * sv;
+                f.segment<3>(3 * v[a]) -= r.k[a] * fs;
+                if (kv) kv->segment<3>(3 * v[a]) += r.k[a] * fv;
             }
-            if (A)
-                for (int a = 0; a < 4; ++a)
-                    for (int b = 0; b < 4; ++b)
-                        A->addDiagonal(mHingeSlots[hi][4 * a + b], cK * c * r.k[a] * r.k[b]);
         }
-
-    // Aerodynamics.
-    if (!in.wind) return;
-    const double cl0 = mMat.lift.at(t), cd0 = mMat.drag.at(t);
-    if (cl0 == 0.0 && cd0 == 0.0) return;
-    const bool paintL = !mTriLift.empty(), paintD = !mTriDrag.empty();
-    for (size_t e = 0; e < nt; ++e) {
-        const auto& tri = mMesh.triangles[e];
-        const Vec3 areaNormal = 0.5 * triangleCross(in.x, tri);
-        const Vec3 wind = (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) / 3.0;
-        const Vec3 u = (vec3At(in.v, tri[0]) + vec3At(in.v, tri[1]) + vec3At(in.v, tri[2])) / 3.0;
-        const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
-        const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
-        const AeroResult r =
-            aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd, mMat.aeroModel, in.aeroJacobian);
-        out.clamped += r.clamped ? 1 : 0;
-        const Vec3 f3 = r.force / 3.0;
-        for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
-        if (A && in.aeroJacobian != AeroJacobian::None)
-            for (int s = 0; s < 9; ++s) A->addBlock(mTriSlots[e][s], r.damping, h / 9.0);
+        // Σ over hinges of cK·Q, summed per slot at setup (mBendCoef).
+        if (A)
+            for (size_t k = 0; k < mBendSlots.size(); ++k)
+                A->addDiagonal(mBendSlots[k], cK * kb * mBendCoef[k]);
     }
+    out.elasticEnergy += energy;
 }
 
 } // namespace gale::solver

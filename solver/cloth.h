@@ -49,7 +49,8 @@ private:
     std::vector<std::array<int, 9>> mTriSlots; // matrix slot of (corner a, corner b), a*3+b
     std::vector<HingeStencil> mHinges;
     std::vector<HingeRest> mHingeRest;
-    std::vector<std::array<int, 16>> mHingeSlots;
+    std::vector<int> mBendSlots;    // matrix slots the hinges touch
+    std::vector<double> mBendCoef;  // per slot: Σ over hinges of scale·k_a·k_b (bending Hessian / k_b)
     std::vector<double> mTriLift, mTriDrag; // mean painted map value per triangle (or empty)
     int mDegenerate = 0;
 };

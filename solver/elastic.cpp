@@ -44,20 +44,13 @@ void materialCoordinates(const Vec3 x[3], const Vec3& warp, Vec3 uv[3]) {
     }
 }
 
-void membraneForces(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
-                    TriangleElastic& out) {
-    out.energy = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        out.f[i].setZero();
-        for (int j = 0; j < 3; ++j) out.K[i][j].setZero();
-    }
-    if (!(rest.area > 0.0)) return;
+bool membraneFactors(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
+                     MembraneFactors& out) {
+    if (!(rest.area > 0.0)) return false;
+    // w_u = Σ a_i x_i, w_v = Σ b_i x_i with a_i = g[2i], b_i = g[2i+1].
     const double* g = rest.g.data();
-    Vec3 wu = Vec3::Zero(), wv = Vec3::Zero();
-    for (int i = 0; i < 3; ++i) {
-        wu += g[2 * i] * x[i];
-        wv += g[2 * i + 1] * x[i];
-    }
+    const Vec3 wu = g[0] * x[0] + g[2] * x[1] + g[4] * x[2];
+    const Vec3 wv = g[1] * x[0] + g[3] * x[1] + g[5] * x[2];
     const double A = rest.area;
     const double lu = wu.norm(), lv = wv.norm();
     const Vec3 hu = lu > 0.0 ? Vec3(wu / lu) : Vec3::Zero();
@@ -68,23 +61,44 @@ void membraneForces(const MembraneRest& rest, const Vec3 x[3], double kStretch, 
     // ∂E/∂w_u, ∂E/∂w_v (per unit area).
     const Vec3 gu = kStretch * (lu - 1.0) * hu + kShear * shear * wv;
     const Vec3 gv = kStretch * (lv - 1.0) * hv + kShear * shear * wu;
-    // Hessian blocks in (w_u, w_v) space.
-    const Mat3 I = Mat3::Identity();
+    // Hessian blocks in (w_u, w_v) space:
+    //   H_uu = S_u + k_sh w_v w_vᵀ,  H_vv = S_v + k_sh w_u w_uᵀ,  H_uv = H_vuᵀ = k_sh w_v w_uᵀ,
+    //   S_u = k_s (ŵ_u ŵ_uᵀ + t_u (I − ŵ_u ŵ_uᵀ)) = k_s ((1 − t_u) ŵ_u ŵ_uᵀ + t_u I)  (S_v alike).
+    // Chain rule, K_ij = A (a_i a_j H_uu + a_i b_j H_uv + b_i a_j H_vu + b_i b_j H_vv); the shear
+    // terms are the outer product of s_i = ∂(w_u·w_v)/∂x_i = a_i w_v + b_i w_u, so
+    //   K_ij = A (a_i a_j S_u + b_i b_j S_v + k_sh s_i s_jᵀ)   (out.Su = A S_u, out.Sv = A S_v).
     const double tu = lu > 1.0 ? 1.0 - 1.0 / lu : 0.0;
     const double tv = lv > 1.0 ? 1.0 - 1.0 / lv : 0.0;
-    const Mat3 Huu = kStretch * (hu * hu.transpose() + tu * (I - hu * hu.transpose())) +
-                     kShear * wv * wv.transpose();
-    const Mat3 Hvv = kStretch * (hv * hv.transpose() + tv * (I - hv * hv.transpose())) +
-                     kShear * wu * wu.transpose();
-    const Mat3 Huv = kShear * wv * wu.transpose();
-    const Mat3 Hvu = Huv.transpose();
+    out.Su = (A * kStretch * (1.0 - tu)) * hu * hu.transpose();
+    out.Su.diagonal().array() += A * kStretch * tu;
+    out.Sv = (A * kStretch * (1.0 - tv)) * hv * hv.transpose();
+    out.Sv.diagonal().array() += A * kStretch * tv;
+    out.shear = A * kShear;
     for (int i = 0; i < 3; ++i) {
         const double ai = g[2 * i], bi = g[2 * i + 1];
+        out.a[i] = ai;
+        out.b[i] = bi;
         out.f[i] = -A * (ai * gu + bi * gv);
-        for (int j = 0; j < 3; ++j) {
-            const double aj = g[2 * j], bj = g[2 * j + 1];
-            out.K[i][j] = A * (ai * aj * Huu + ai * bj * Huv + bi * aj * Hvu + bi * bj * Hvv);
+        out.s[i] = ai * wv + bi * wu;
+    }
+    return true;
+}
+
+void membraneForces(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
+                    TriangleElastic& out) {
+    MembraneFactors m;
+    if (!membraneFactors(rest, x, kStretch, kShear, m)) {
+        out.energy = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            out.f[i].setZero();
+            for (int j = 0; j < 3; ++j) out.K[i][j].setZero();
         }
+        return;
+    }
+    out.energy = m.energy;
+    for (int i = 0; i < 3; ++i) {
+        out.f[i] = m.f[i];
+        for (int j = 0; j < 3; ++j) out.K[i][j] = m.block(i, j);
     }
 }
 

@@ -37,6 +37,26 @@ struct TriangleElastic {
 void membraneForces(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
                     TriangleElastic& out);
 
+// The same in the factored form assembly uses (cheaper than the nine blocks): with
+// a_i = ∂w_u/∂x_i, b_i = ∂w_v/∂x_i (rest.g) and s_i = ∂(w_u·w_v)/∂x_i = a_i w_v + b_i w_u,
+//   K_ij = a_i a_j S_u + b_i b_j S_v + c s_i s_jᵀ,   S_u, S_v symmetric PSD, c = A k_sh,
+// so K_ji = K_ijᵀ and K v needs only ẇ_u = Σ a_j v_j, ẇ_v = Σ b_j v_j and Σ s_j·v_j:
+//   (K v)_i = a_i S_u ẇ_u + b_i S_v ẇ_v + c (Σ_j s_j·v_j) s_i.
+struct MembraneFactors {
+    double energy = 0.0;
+    Vec3 f[3];
+    double a[3], b[3];
+    Mat3 Su, Sv; // A k_s ((1 − t) ŵ ŵᵀ + t I) of w_u and w_v, t = max(0, 1 − 1/|w|)
+    double shear = 0.0; // c = A k_sh
+    Vec3 s[3];
+    Mat3 block(int i, int j) const {
+        return (a[i] * a[j]) * Su + (b[i] * b[j]) * Sv + (shear * s[i]) * s[j].transpose();
+    }
+};
+// False (and `out` untouched) for a degenerate rest triangle.
+bool membraneFactors(const MembraneRest& rest, const Vec3 x[3], double kStretch, double kShear,
+                     MembraneFactors& out);
+
 // ---- Cloth bending: Bergou, Wardetzky, Harmon, Zorin, Grinspun, "A Quadratic Bending Model for
 // Inextensible Surfaces", SGP 2006. For the hinge over edge (x0, x1) with opposite corners x2,
 // x3 and the angles α, γ at x0 and β, δ at x1 in the two triangles:

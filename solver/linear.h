@@ -40,8 +40,8 @@ public:
     void setZero();
     // values(i, j) += scale * b
     void addBlock(int slot, const Mat3& b, double scale = 1.0) {
-        double* p = mVal.data() + 9 * static_cast<size_t>(slot);
-        const double* q = b.data(); // column-major, as stored
+        double* __restrict p = mVal.data() + 9 * static_cast<size_t>(slot);
+        const double* __restrict q = b.data(); // column-major, as stored; never inside mVal
         for (int k = 0; k < 9; ++k) p[k] += scale * q[k];
     }
     void addDiagonal(int slot, double value) {
