@@ -35,17 +35,19 @@ struct ScalarOps {
     }
     static V add(V u, V v) { return {u.a + v.a, u.b + v.b, u.c + v.c}; }
     static V sub(V u, V v) { return {u.a - v.a, u.b - v.b, u.c - v.c}; }
+    using B = Vec3d;
+    static B broadcast(V y) { return y; }
+    template <class T>
+    static V block(const T* m, const B& x) {
+        return {double(m[0]) * x.a + double(m[3]) * x.b + double(m[6]) * x.c,
+                double(m[1]) * x.a + double(m[4]) * x.b + double(m[7]) * x.c,
+                double(m[2]) * x.a + double(m[5]) * x.b + double(m[8]) * x.c};
+    }
     template <class T>
     static V block(const T* m, const double* x) {
-        const double x0 = x[0], x1 = x[1], x2 = x[2];
-        return {double(m[0]) * x0 + double(m[3]) * x1 + double(m[6]) * x2,
-                double(m[1]) * x0 + double(m[4]) * x1 + double(m[7]) * x2,
-                double(m[2]) * x0 + double(m[5]) * x1 + double(m[8]) * x2};
+        return block(m, B{x[0], x[1], x[2]});
     }
-    static V blockTimes(const double* m, V y) {
-        const double v[3] = {y.a, y.b, y.c};
-        return block(m, v);
-    }
+    static V blockTimes(const double* m, V y) { return block(m, y); }
 };
 
 bool cpuHasAvx2Fma() {

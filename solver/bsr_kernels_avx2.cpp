@@ -26,18 +26,24 @@ struct WideOps {
     static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
     static V column(const double* p) { return _mm256_loadu_pd(p); }
     static V column(const float* p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
+    // x₀, x₁, x₂ each in all lanes.
+    struct B {
+        V x0, x1, x2;
+    };
+    static B broadcast(V y) {
+        return {_mm256_permute4x64_pd(y, 0x00), _mm256_permute4x64_pd(y, 0x55), _mm256_permute4x64_pd(y, 0xAA)};
+    }
     // A x = a₀ x₀ + a₁ x₁ + a₂ x₂ for the column-major block at b.
     template <class T>
+    static V block(const T* b, const B& x) {
+        const V s = _mm256_mul_pd(column(b), x.x0);
+        return _mm256_fmadd_pd(column(b + 6), x.x2, _mm256_fmadd_pd(column(b + 3), x.x1, s));
+    }
+    template <class T>
     static V block(const T* b, const double* x) {
-        V s = _mm256_mul_pd(column(b), _mm256_broadcast_sd(x));
-        s = _mm256_fmadd_pd(column(b + 3), _mm256_broadcast_sd(x + 1), s);
-        return _mm256_fmadd_pd(column(b + 6), _mm256_broadcast_sd(x + 2), s);
+        return block(b, B{_mm256_broadcast_sd(x), _mm256_broadcast_sd(x + 1), _mm256_broadcast_sd(x + 2)});
     }
-    static V blockTimes(const double* b, V y) {
-        V s = _mm256_mul_pd(column(b), _mm256_permute4x64_pd(y, 0x00));
-        s = _mm256_fmadd_pd(column(b + 3), _mm256_permute4x64_pd(y, 0x55), s);
-        return _mm256_fmadd_pd(column(b + 6), _mm256_permute4x64_pd(y, 0xAA), s);
-    }
+    static V blockTimes(const double* b, V y) { return block(b, broadcast(y)); }
 };
 
 } // namespace

@@ -1,5 +1,5 @@
 // The loops of the block kernels (bsr_kernels.h), written once over a small "Ops" type that
-// supplies a 3-vector and its arithmetic; bsr_kernels.cpp instantiates them with scalar
+// supplies a 3-vector V, a 3-vector B broadcast for products, and their arithmetic; bsr_kernels.cpp instantiates them with scalar
 // doubles, bsr_kernels_avx2.cpp with AVX2 + FMA registers. Private to those two files.
 #pragma once
 
@@ -29,23 +29,28 @@ inline void sweep(const GaussSeidelSweep& g) {
     const int* diag = g.pattern.diag;
     const int n = g.pattern.n;
     const float* val = g.val;
+    const int* mirror = g.mirror;
+    const double* dinv = g.dinv;
+    const double* r = g.r;
     double* x = g.x;
+    double* t = g.t; // (locals: the stores below might alias `g` for all the compiler knows)
     for (int s = 0; s < n; ++s) {
         const int i = Forward ? s : n - 1 - s;
-        typename Ops::V y = Ops::load3(g.r + 3 * static_cast<std::size_t>(i));
+        typename Ops::V y = Ops::load3(r + 3 * static_cast<std::size_t>(i));
         const int end = FromZero ? diag[i] : start[i + 1];
         for (int k = start[i]; k < end; ++k)
             y = Ops::sub(y, Ops::block(val + 9 * static_cast<std::size_t>(k), x + 3 * static_cast<std::size_t>(cols[k])));
         double* xi = x + 3 * static_cast<std::size_t>(i);
-        Ops::store3(xi, Ops::add(Ops::load3(xi), Ops::blockTimes(g.dinv + 9 * static_cast<std::size_t>(i), y)));
+        const typename Ops::V xNew = Ops::blockTimes(dinv + 9 * static_cast<std::size_t>(i), y);
+        Ops::store3(xi, FromZero ? xNew : Ops::add(Ops::load3(xi), xNew));
         if (!Residual) continue;
         // t_j −= A_ji x_i for the earlier rows j; row i itself is satisfied (t_i = 0) until the
         // later rows subtract their part.
-        double* t = g.t;
         Ops::store3(t + 3 * static_cast<std::size_t>(i), Ops::zero());
+        const typename Ops::B xb = Ops::broadcast(xNew);
         for (int k = start[i]; k < end; ++k) {
             double* tj = t + 3 * static_cast<std::size_t>(cols[k]);
-            Ops::store3(tj, Ops::sub(Ops::load3(tj), Ops::block(val + 9 * static_cast<std::size_t>(g.mirror[k]), xi)));
+            Ops::store3(tj, Ops::sub(Ops::load3(tj), Ops::block(val + 9 * static_cast<std::size_t>(mirror[k]), xb)));
         }
     }
 }

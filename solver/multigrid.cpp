@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace gale::solver {
 
@@ -182,12 +183,11 @@ void BlockMultigrid::coarsen(int l) {
     BsrMatrix& c = mLevels[l + 1].a;
     std::fill(c.val.begin(), c.val.end(), 0.0);
     const BsrMatrix& a = f.a;
-    for (int i = 0; i < a.n; ++i)
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-            double* dst = c.val.data() + 9 * static_cast<size_t>(f.coarseSlot[k]);
-            const double* src = a.val.data() + 9 * static_cast<size_t>(k);
-            for (int q = 0; q < 9; ++q) dst[q] += src[q];
-        }
+    for (int k = 0; k < a.blocks(); ++k) {
+        double* __restrict dst = c.val.data() + 9 * static_cast<size_t>(f.coarseSlot[k]);
+        const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(k);
+        for (int q = 0; q < 9; ++q) dst[q] += src[q];
+    }
     if (l != 0 || mKind.empty()) return;
     for (int i = 0; i < a.n; ++i) {
         if (!mKind[i]) continue;
@@ -225,15 +225,25 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     // twin for the smoother and the CG products, and the finiteness check.
     std::vector<float>& low = mLevels[0].lowVal;
     low.resize(a.val.size());
-    const double* src = A.values();
-    bool finite = true;
-    for (size_t k = 0; k < a.val.size(); ++k) {
-        const double v = src[k];
-        a.val[k] = v;
-        low[k] = static_cast<float>(v);
-        finite &= std::isfinite(v);
+    {
+        const double* __restrict src = A.values();
+        double* __restrict dst = a.val.data();
+        float* __restrict lo = low.data();
+        for (size_t k = 0; k < a.val.size(); ++k) {
+            dst[k] = src[k];
+            lo[k] = static_cast<float>(src[k]);
+        }
     }
-    if (!finite) return false;
+    // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or a
+    // value beyond float range, which the smoother could not use either); integer bit tests
+    // vectorise where isfinite on doubles does not.
+    uint32_t bad = 0;
+    for (const float& v : low) {
+        uint32_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        bad |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+    }
+    if (bad) return false;
     auto lower = [&](int k) {
         for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
             low[q] = static_cast<float>(a.val[q]);
