@@ -1,7 +1,9 @@
 // The block kernels against dense Eigen references, for the portable kernels and (where the
 // CPU has them) the AVX2 + FMA ones: block-row products in double and single precision, the
-// forward and backward Gauss–Seidel sweeps, and the fused residual of the forward sweep.
+// forward and backward Gauss–Seidel sweeps, and the fused residual of the forward sweep; a flag
+// simulated with either set of kernels.
 #include "solver/bsr_kernels.h"
+#include "solver/test_support.h"
 #include "solver/types.h"
 
 #include <catch2/catch.hpp>
@@ -195,4 +197,50 @@ TEST_CASE("bsr kernels: the forward sweep from zero leaves t = r - A x", "[bsr]"
         CHECK((t - residual).norm() < 1e-12 * r.norm());
         CHECK(residual.norm() > 1e-3 * r.norm()); // one sweep does not solve the system
     });
+}
+
+TEST_CASE("bsr kernels: a flag in gusty wind moves the same with either set of kernels", "[bsr]") {
+    // The kernels differ only in rounding (FMA, summation in lanes), so two runs of a 0.25 s flag
+    // must agree far inside the effect of the CG tolerance (1e-3) on the motion, measured here
+    // against a run at 1e-7.
+    const TriMesh mesh = makeGrid(1.0, 1.0, 24, 24, Vec3(0, 1, 0));
+    auto run = [&mesh](bool wide, double tolerance) {
+        const bool initial = wideKernels();
+        setWideKernels(wide);
+        WorldSettings ws;
+        ws.fps = 96.0;
+        ws.substeps = 1;
+        World w(ws);
+        w.setWind(std::make_shared<testing::LambdaField>([](const Vec3& x, double t) {
+            return Vec3(10.0 * (1.0 + 0.3 * std::sin(3.0 * t + 2.0 * x.y())), 2.0 * std::cos(5.0 * t + 3.0 * x.x()), 1.0);
+        }));
+        ClothMaterial m;
+        m.density = 0.1;
+        m.stretch = gale::fields::Param(2000.0);
+        m.shear = gale::fields::Param(200.0);
+        m.bend = gale::fields::Param(1e-4);
+        auto c = std::make_unique<Cloth>("flag", mesh, m);
+        PinSet pins;
+        pins.vertices = testing::gridColumn(24, 24, 0);
+        c->addPins(pins);
+        c->options().cgTolerance = tolerance;
+        w.addBody(std::move(c));
+        for (int f = 1; f <= 24; ++f) REQUIRE_FALSE(w.advanceFrame(f).failed);
+        setWideKernels(initial);
+        return VecX(w.bodies()[0]->positions());
+    };
+    const VecX rest = Eigen::Map<const VecX>(mesh.positions.data(), mesh.positions.size());
+    const VecX portable = run(false, 1e-3), tight = run(false, 1e-7);
+    REQUIRE(portable.allFinite());
+    CHECK((portable - rest).norm() > 0.1); // it did move
+    const double toleranceEffect = (portable - tight).norm();
+    CHECK(toleranceEffect > 0.0);
+    const bool initial = wideKernels();
+    setWideKernels(true);
+    const bool available = wideKernels();
+    setWideKernels(initial);
+    if (!available) return; // no AVX2 + FMA on this CPU: nothing to compare
+    const VecX wide = run(true, 1e-3);
+    INFO("kernels differ by " << (wide - portable).norm() << " m, the tolerance's effect " << toleranceEffect << " m");
+    CHECK((wide - portable).norm() < 0.01 * toleranceEffect);
 }
