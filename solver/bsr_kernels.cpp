@@ -69,20 +69,23 @@ std::atomic<bool>& wideSwitch() {
 bool wideKernels() { return wideSwitch().load(std::memory_order_relaxed); }
 void setWideKernels(bool on) { wideSwitch().store(on && cpuHasAvx2Fma(), std::memory_order_relaxed); }
 
-void bsrMultiplyRows(const BsrPattern& m, const double* val, const double* x, double* y, std::size_t i0,
-                     std::size_t i1) {
+namespace {
+template <class T>
+void multiplyRows(const BsrPattern& m, const T* val, const double* x, double* y, std::size_t i0, std::size_t i1) {
 #if defined(GALE_HAVE_AVX2_KERNELS)
     if (wideKernels()) return bsrMultiplyRowsAvx2(m, val, x, y, i0, i1);
 #endif
     kernels::multiplyRows<ScalarOps>(m, val, x, y, i0, i1);
 }
+} // namespace
 
+void bsrMultiplyRows(const BsrPattern& m, const double* val, const double* x, double* y, std::size_t i0,
+                     std::size_t i1) {
+    multiplyRows(m, val, x, y, i0, i1);
+}
 void bsrMultiplyRows(const BsrPattern& m, const float* val, const double* x, double* y, std::size_t i0,
                      std::size_t i1) {
-#if defined(GALE_HAVE_AVX2_KERNELS)
-    if (wideKernels()) return bsrMultiplyRowsAvx2(m, val, x, y, i0, i1);
-#endif
-    kernels::multiplyRows<ScalarOps>(m, val, x, y, i0, i1);
+    multiplyRows(m, val, x, y, i0, i1);
 }
 
 void gaussSeidelSweep(const GaussSeidelSweep& g) {

@@ -113,6 +113,18 @@ void referenceSweep(const RandomBsr& m, const Eigen::VectorXd& r, Eigen::VectorX
     }
 }
 
+// A sweep of m's single-precision matrix on A x = r.
+GaussSeidelSweep sweepOf(const RandomBsr& m, const Eigen::VectorXd& r, Eigen::VectorXd& x) {
+    GaussSeidelSweep g;
+    g.pattern = m.pattern();
+    g.val = m.single.data();
+    g.mirror = m.mirror.data();
+    g.dinv = m.dinv.data();
+    g.r = r.data();
+    g.x = x.data();
+    return g;
+}
+
 double relErr(const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return (a - b).norm() / b.norm(); }
 
 // Runs `body` with the portable kernels and, where available, with the wide ones.
@@ -159,13 +171,7 @@ TEST_CASE("bsr kernels: forward and backward Gauss-Seidel sweeps equal the dense
         referenceSweep(m, r, want, forward);
         forEachKernel([&] {
             Eigen::VectorXd x = x0;
-            GaussSeidelSweep g;
-            g.pattern = m.pattern();
-            g.val = m.single.data();
-            g.mirror = m.mirror.data();
-            g.dinv = m.dinv.data();
-            g.r = r.data();
-            g.x = x.data();
+            GaussSeidelSweep g = sweepOf(m, r, x);
             g.forward = forward;
             gaussSeidelSweep(g);
             INFO((forward ? "forward" : "backward"));
@@ -181,13 +187,7 @@ TEST_CASE("bsr kernels: the forward sweep from zero leaves t = r - A x", "[bsr]"
     referenceSweep(m, r, want, true);
     forEachKernel([&] {
         Eigen::VectorXd x = Eigen::VectorXd::Zero(3 * m.n), t = Eigen::VectorXd::Constant(3 * m.n, 5.0);
-        GaussSeidelSweep g;
-        g.pattern = m.pattern();
-        g.val = m.single.data();
-        g.mirror = m.mirror.data();
-        g.dinv = m.dinv.data();
-        g.r = r.data();
-        g.x = x.data();
+        GaussSeidelSweep g = sweepOf(m, r, x);
         g.t = t.data();
         g.fromZero = true;
         gaussSeidelSweep(g);

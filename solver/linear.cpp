@@ -120,6 +120,22 @@ void Constraints::apply(double* x) const {
 // ---------------------------------------------------------------------------------------------
 // FilteredSolver
 
+namespace {
+// A right-hand side that needs no iterations: non-finite (failed) or zero (y = 0, converged).
+bool trivialRhs(double rhsNorm, VecX& y, SolveStatus& st) {
+    if (!std::isfinite(rhsNorm)) {
+        st.failed = true;
+        return true;
+    }
+    if (rhsNorm == 0.0) {
+        y.setZero();
+        st.converged = true;
+        return true;
+    }
+    return false;
+}
+} // namespace
+
 void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x,
                                    VecX& out) {
     // Â x = S A S x + (I − S) x; S = I except at the constrained vertices (mConstrained).
@@ -213,15 +229,7 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
         });
     };
     const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
-    if (!std::isfinite(rhsNorm)) {
-        st.failed = true;
-        return st;
-    }
-    if (rhsNorm == 0.0) {
-        y.setZero();
-        st.converged = true;
-        return st;
-    }
+    if (trivialRhs(rhsNorm, y, st)) return st;
     mR.resize(n3);
     mZ.resize(n3);
     mP.resize(n3);
@@ -355,15 +363,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     SolveStatus st;
     const size_t n3 = 3 * static_cast<size_t>(A.size());
     const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
-    if (!std::isfinite(rhsNorm)) {
-        st.failed = true;
-        return st;
-    }
-    if (rhsNorm == 0.0) {
-        y.setZero();
-        st.converged = true;
-        return st;
-    }
+    if (trivialRhs(rhsNorm, y, st)) return st;
     if (!mMultigrid.refresh(A, c, mConstrained)) {
         st.failed = true;
         return st;
