@@ -4,7 +4,9 @@
 //   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size N]
 //   [--solver NAME]  (DIR gets CSV tables and SVG plots; --only runs one section; --size N and
 //   --solver NAME keep only those rows of the scaling table, e.g. to profile one of them)
+#include "solver/bsr_kernels.h"
 #include "solver/cloth.h"
+#include "solver/linear.h"
 #include "solver/world.h"
 
 #include <chrono>
@@ -356,6 +358,39 @@ void scalingBench(bool quick, int onlySize, const std::string& onlySolver) {
             std::printf("| %dx%d | %s | %.2f | %.2f | %.2f | %.1f |\n", n, n, s.name, cpu * 1e6 / (n * n),
                         per * 1e6 / (n * n), cpu * 1e3, double(r.iterations) / std::max<long>(r.substeps, 1));
         }
+    // The knobs of the multigrid solve at 64x64: the vector kernels (AVX2 + FMA against the
+    // portable ones) and the precision of CG's products (single from kSinglePrecisionTolerance
+    // up, double just below it), with the position difference after the run.
+    if ((onlySize <= 0 || onlySize == 64) && (onlySolver.empty() || onlySolver == "multigrid")) {
+        struct Knob {
+            const char* name;
+            bool wide;
+            double tol;
+        };
+        const bool wideAvailable = wideKernels();
+        const Knob knobs[] = {{"AVX2 + FMA kernels, single-precision products", true, kSinglePrecisionTolerance},
+                              {"AVX2 + FMA kernels, double-precision products", true, 0.99 * kSinglePrecisionTolerance},
+                              {"portable kernels, single-precision products", false, kSinglePrecisionTolerance}};
+        std::printf("\n64x64 multigrid knobs (CG tol %g; RMS position difference against the first row after 72 steps):\n\n"
+                    "| kernels, CG products | us/vertex/step (CPU) | CG its/step | RMS difference (m) |\n|---|---|---|---|\n",
+                    kSinglePrecisionTolerance);
+        VecX first;
+        for (const Knob& k : knobs) {
+            if (k.wide && !wideAvailable) continue;
+            setWideKernels(k.wide);
+            FlagSpec f;
+            f.n = 64;
+            f.wind = 12.0;
+            auto w = makeFlag(f, 240.0, 1, false, k.tol, 0);
+            setSolver(*w, kSolvers[1]);
+            runFrames(*w, 24);
+            const RunResult r = runFrames(*w, 48);
+            if (first.size() == 0) first = r.x;
+            std::printf("| %s | %.2f | %.1f | %.2e |\n", k.name, r.cpuSeconds / r.substeps * 1e6 / (64 * 64),
+                        double(r.iterations) / r.substeps, rms(r.x, first));
+        }
+        setWideKernels(wideAvailable);
+    }
     // The real-time check: 32x32 at 24 fps with 4 substeps (h = 1/96 s).
     if ((onlySize > 0 && onlySize != 32) || !onlySolver.empty()) return;
     std::printf("\n");
