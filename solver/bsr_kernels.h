@@ -1,6 +1,6 @@
 // The inner loops of the 3×3-block sparse solvers — block-row products and block Gauss–Seidel
-// sweeps — written once with 4-wide vectors and compiled twice: for any x86-64 and for
-// AVX2 + FMA, picked at run time (the portable build still gets the wide path where it exists).
+// sweeps — written once (bsr_kernels_body.h) and compiled twice: scalar for any x86-64, and
+// 4-wide for AVX2 + FMA, picked at run time (so the portable build uses AVX2 where it exists).
 #pragma once
 
 #include <cstddef>
@@ -10,7 +10,7 @@ namespace gale::solver {
 // The pattern of a block-CSR matrix: block row i holds slots start[i] .. start[i+1], column
 // cols[k] of slot k, sorted; diag[i] is the slot of (i, i). Values are 9 per slot, column-major
 // (val[9k + 3c + r] = A(r, c)), and every value array carries kBsrPad extra entries at its
-// end: a block is read as three 4-wide columns, the last one a value past the block.
+// end: a block is read as three 4-wide columns, each one value longer than the column.
 struct BsrPattern {
     const int* start = nullptr;
     const int* cols = nullptr;
@@ -45,8 +45,9 @@ struct GaussSeidelSweep {
 };
 void gaussSeidelSweep(const GaussSeidelSweep& s);
 
-// Whether the AVX2 + FMA kernels are in use (the CPU has them and they are not switched off);
-// tests switch them off to check the portable kernels against the same references.
+// Whether the AVX2 + FMA kernels are in use (built, the CPU has them, and not switched off);
+// tests switch them off to check the portable kernels against the same references. The
+// switch is process-wide: flip it only while no solve runs.
 bool wideKernels();
 void setWideKernels(bool on);
 
