@@ -29,8 +29,9 @@ printf 'x,y,z\n0.5,0,0\n' > shot/p.csv
 
 cd shot
 # Every reader, every escape: refused; inside the folder: read.
-for call in 'sdf(F, $P)' 'sdfgrad(F, $P)' 'shadow(F, $P, [1, 0, 0], 1)' 'meshvel(F, $P, 1)' \
-    'vdb(V, "vel", $P)'; do
+# (@ stands for the file: mktemp's names never hold it, so the path cannot be substituted into.)
+for call in 'sdf(@, $P)' 'sdfgrad(@, $P)' 'shadow(@, $P, [1, 0, 0], 1)' 'meshvel(@, $P, 1)' \
+    'vdb(@, "vel", $P)'; do
     for name in box.obj '../shared/box.obj' "$TMP/shared/box.obj" link.obj linkdir/box.obj \
         'linkdir/../shared/box.obj' 'maps/../../shared/box.obj'; do
         fname=$name
@@ -38,8 +39,7 @@ for call in 'sdf(F, $P)' 'sdfgrad(F, $P)' 'shadow(F, $P, [1, 0, 0], 1)' 'meshvel
         meshvel*) fname=${fname/box.obj/m.#.obj}; fname=${fname/link.obj/link.#.obj} ;;
         vdb*) fname=${fname/box.obj/w.vdb}; fname=${fname/link.obj/link.vdb} ;;
         esac
-        expr=${call/F/\"$fname\"}
-        expr=${expr/V/\"$fname\"}
+        expr=${call/@/\"$fname\"}
         run "$GALE" eval -e "$expr" --points p.csv
         if [ "$name" = box.obj ]; then
             expect_rc 0 "$expr inside the folder"
