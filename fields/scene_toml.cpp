@@ -5,6 +5,7 @@
 #include "fields/pointset.h"
 #include "fields/presets.h"
 #include "fields/scene.h"
+#include "fields/set_value.h"
 #include "lang/functions.h"
 
 #include <toml++/toml.h>
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -177,35 +179,13 @@ void Loader::applySets(toml::table& root) {
             mOptions.foreignSections.end())
             continue; // the solver's loader applies it
 
-        // The value as TOML (`12`, `[1, 0, 0]`, `{ keys = ... }`, `"text"`), else a comma list of
-        // numbers (`1,0,0`), else a bare string (`smooth`).
-        const std::string origin = std::string(kSetPrefix) + set;
-        toml::table doc;
-        bool parsed = false;
-        for (const std::string& candidate : {text, "[" + text + "]"}) {
-            try {
-                doc = toml::parse("v = " + candidate, origin);
-                parsed = true;
-                break;
-            } catch (const toml::parse_error&) {
-            }
-        }
+        // The value as TOML, else a comma list of numbers, else a bare string (set_value.h).
+        std::optional<toml::table> parsed = parseSetValue(text, std::string(kSetPrefix) + set);
         if (!parsed) {
-            std::string quoted = "\"";
-            for (char c : text) {
-                if (c == '"' || c == '\\') quoted += '\\';
-                quoted += c;
-            }
-            try {
-                doc = toml::parse("v = " + quoted + "\"", origin);
-                parsed = true;
-            } catch (const toml::parse_error&) {
-            }
-        }
-        if (!parsed || !doc.get("v")) {
             setError(set, "cannot read the value '" + text + "'");
             continue;
         }
+        toml::table doc = std::move(*parsed);
 
         toml::table* target = nullptr;
         size_t next = 1;

@@ -4,6 +4,8 @@
 #include "solver/scene.h"
 #include "solver/mesh_collider.h"
 
+#include "fields/set_value.h"
+
 #include "lang/functions.h"
 
 #include <toml++/toml.h>
@@ -168,33 +170,13 @@ void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) 
         const std::string& head = parts[0];
         if (head != "cloth" && head != "hair" && head != "collider" && head != "solver") continue;
 
-        const std::string origin = std::string(kSetPrefix) + set;
-        toml::table doc;
-        bool parsed = false;
-        for (const std::string& candidate : {text, "[" + text + "]"}) {
-            try {
-                doc = toml::parse("v = " + candidate, origin);
-                parsed = true;
-                break;
-            } catch (const toml::parse_error&) {
-            }
-        }
+        // The value as TOML, else a comma list of numbers, else a bare string (set_value.h).
+        std::optional<toml::table> parsed = fields::parseSetValue(text, std::string(kSetPrefix) + set);
         if (!parsed) {
-            std::string quoted = "\"";
-            for (char c : text) {
-                if (c == '"' || c == '\\') quoted += '\\';
-                quoted += c;
-            }
-            try {
-                doc = toml::parse("v = " + quoted + "\"", origin);
-                parsed = true;
-            } catch (const toml::parse_error&) {
-            }
-        }
-        if (!parsed || !doc.get("v")) {
             setError(set, "cannot read the value '" + text + "'");
             continue;
         }
+        toml::table doc = std::move(*parsed);
         toml::table* target = nullptr;
         size_t next = 1;
         std::string where = head;
