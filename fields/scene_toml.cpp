@@ -5,7 +5,7 @@
 #include "fields/pointset.h"
 #include "fields/presets.h"
 #include "fields/scene.h"
-#include "fields/set_value.h"
+#include "fields/scene_toml_util.h"
 #include "lang/functions.h"
 
 #include <toml++/toml.h>
@@ -26,50 +26,6 @@ namespace gale::fields {
 namespace {
 
 constexpr std::string_view kSetPrefix = "--set ";
-
-std::string trim(std::string_view s) {
-    size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
-    return a == std::string_view::npos ? std::string() : std::string(s.substr(a, b - a + 1));
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> parts;
-    std::string part;
-    std::stringstream in(s);
-    while (std::getline(in, part, sep)) parts.push_back(part);
-    if (!s.empty() && s.back() == sep) parts.push_back("");
-    return parts;
-}
-
-std::string joinNames(const std::vector<std::string>& names) {
-    std::string out;
-    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-    return out;
-}
-
-// "did you mean 'x'?" among `candidates`, or empty.
-std::string didYouMean(const std::string& name, const std::vector<std::string>& candidates) {
-    std::vector<std::string_view> views(candidates.begin(), candidates.end());
-    std::string_view close = lang::closestName(name, views);
-    return close.empty() ? std::string() : "did you mean '" + std::string(close) + "'?";
-}
-
-bool isNumber(const toml::node& n) { return n.is_integer() || n.is_floating_point(); }
-
-const char* typeName(const toml::node& n) {
-    switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    default: return "nothing";
-    }
-}
 
 class Loader {
 public:
@@ -165,9 +121,9 @@ private:
 void Loader::applySets(toml::table& root) {
     for (const std::string& set : mOptions.sets) {
         const size_t eq = set.find('=');
-        const std::string key = trim(eq == std::string::npos ? set : set.substr(0, eq));
-        const std::string text = eq == std::string::npos ? std::string() : trim(set.substr(eq + 1));
-        const std::vector<std::string> parts = split(key, '.');
+        const std::string key = trimText(eq == std::string::npos ? set : set.substr(0, eq));
+        const std::string text = eq == std::string::npos ? std::string() : trimText(set.substr(eq + 1));
+        const std::vector<std::string> parts = splitText(key, '.');
         if (eq == std::string::npos || key.empty() || text.empty() ||
             std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
             setError(set, "expected KEY=VALUE with a dotted scene path, e.g. windicator.speed=12, "
@@ -251,7 +207,7 @@ void Loader::applySets(toml::table& root) {
             }
             target = child->as_table();
             if (!target) {
-                setError(set, "'" + where + "' is " + typeName(*child) + ", not a table");
+                setError(set, "'" + where + "' is " + tomlTypeName(*child) + ", not a table");
                 ok = false;
             }
         }
@@ -275,8 +231,8 @@ void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& all
 }
 
 bool Loader::number(const toml::node& n, const std::string& what, double& out) {
-    if (!isNumber(n)) {
-        error(n, what + " must be a number, not " + typeName(n));
+    if (!isTomlNumber(n)) {
+        error(n, what + " must be a number, not " + tomlTypeName(n));
         return false;
     }
     const double v = n.value<double>().value_or(0.0);
@@ -299,13 +255,13 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
         return true;
     }
     error(n, what + " must be a whole number, not " +
-                 (n.is_floating_point() ? std::string("a fraction") : typeName(n)));
+                 (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
     return false;
 }
 
 bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
     if (!n.is_string()) {
-        error(n, what + " must be a string, not " + typeName(n));
+        error(n, what + " must be a string, not " + tomlTypeName(n));
         return false;
     }
     out = n.value<std::string>().value_or("");
@@ -315,14 +271,14 @@ bool Loader::string(const toml::node& n, const std::string& what, std::string& o
 // A number or an array of numbers (false without a report: the caller words the error).
 bool Loader::vectorValue(const toml::node& n, std::vector<double>& out) {
     out.clear();
-    if (isNumber(n)) {
+    if (isTomlNumber(n)) {
         out.push_back(n.value<double>().value_or(0.0));
         return std::isfinite(out[0]);
     }
     const toml::array* a = n.as_array();
     if (!a || a->empty() || a->size() > static_cast<size_t>(lang::kMaxWidth)) return false;
     for (const toml::node& e : *a) {
-        if (!isNumber(e)) return false;
+        if (!isTomlNumber(e)) return false;
         out.push_back(e.value<double>().value_or(0.0));
         if (!std::isfinite(out.back())) return false;
     }
@@ -344,7 +300,7 @@ std::optional<Param> Loader::param(const toml::node& n, const std::string& what,
                      " or a keyframed curve { keys = [[t0, v0], [t1, v1]], interp = \"linear\" }" +
                      (n.is_array() ? std::string(" (this array is empty, longer than 16 or holds "
                                                  "something other than numbers)")
-                                   : ", not " + std::string(typeName(n))));
+                                   : ", not " + std::string(tomlTypeName(n))));
         return std::nullopt;
     }
     if (width && static_cast<int>(v.size()) != width) {
@@ -399,7 +355,7 @@ std::optional<Param> Loader::keyframes(const toml::table& t, const std::string& 
         const toml::array* pair = k.as_array();
         double time = 0.0;
         std::vector<double> value;
-        if (!pair || pair->size() != 2 || !isNumber(*pair->get(0))) {
+        if (!pair || pair->size() != 2 || !isTomlNumber(*pair->get(0))) {
             error(k, what + ": each key must be [time, value] (time in seconds)");
             ok = false;
             continue;
@@ -658,7 +614,7 @@ void Loader::loadField(const toml::table& t, size_t index, const std::string& ba
     }
     if (const toml::node* n = t.get("mask")) {
         if (string(*n, what + ": mask", f.mask)) {
-            if (trim(f.mask).empty())
+            if (trimText(f.mask).empty())
                 error(*n, what + ": mask must be an expression, e.g. mask = \"smoothstep($P[1], 0, 2)\"");
             else
                 verbatimPosition(*n, f.mask, f.maskLine, f.maskCol);
@@ -758,7 +714,7 @@ void Loader::load(const toml::table& root, Scene& out) {
             if (const toml::table* t = e.as_table())
                 list.push_back(t);
             else
-                error(e, std::string("each ") + section + " must be a table, not " + typeName(e));
+                error(e, std::string("each ") + section + " must be a table, not " + tomlTypeName(e));
         }
         return list;
     };

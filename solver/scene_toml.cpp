@@ -4,7 +4,7 @@
 #include "solver/scene.h"
 #include "solver/mesh_collider.h"
 
-#include "fields/set_value.h"
+#include "fields/scene_toml_util.h"
 
 #include "lang/functions.h"
 
@@ -20,52 +20,20 @@
 
 namespace gale::solver {
 
+using fields::didYouMean;
+using fields::isTomlNumber;
+using fields::joinNames;
+using fields::parseSetValue;
+using fields::splitText;
+using fields::tomlTypeName;
+using fields::trimText;
+
 namespace {
 
 constexpr std::string_view kSetPrefix = "--set ";
 // Generated cloth and hair grids: at most this many vertices (a million already takes the
 // implicit solver minutes a frame and gigabytes).
 constexpr long long kMaxGridVertices = 1LL << 20;
-
-std::string trim(std::string_view s) {
-    const size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
-    return a == std::string_view::npos ? std::string() : std::string(s.substr(a, b - a + 1));
-}
-
-std::vector<std::string> splitDots(const std::string& s) {
-    std::vector<std::string> parts;
-    std::string part;
-    std::stringstream in(s);
-    while (std::getline(in, part, '.')) parts.push_back(part);
-    if (!s.empty() && s.back() == '.') parts.push_back("");
-    return parts;
-}
-
-std::string joinNames(const std::vector<std::string>& names) {
-    std::string out;
-    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-    return out;
-}
-
-std::string didYouMean(const std::string& name, const std::vector<std::string>& candidates) {
-    std::vector<std::string_view> views(candidates.begin(), candidates.end());
-    std::string_view close = lang::closestName(name, views);
-    return close.empty() ? std::string() : "did you mean '" + std::string(close) + "'?";
-}
-
-bool isNumber(const toml::node& n) { return n.is_integer() || n.is_floating_point(); }
-
-const char* typeName(const toml::node& n) {
-    switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    default: return "a date or time";
-    }
-}
 
 const std::vector<std::string> kClothKeys = {
     "name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift", "drag",
@@ -161,9 +129,9 @@ void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) 
     for (const std::string& set : sets) {
         const size_t eq = set.find('=');
         if (eq == std::string::npos) continue; // the wind loader reports the malformed ones
-        const std::string key = trim(set.substr(0, eq));
-        const std::string text = trim(set.substr(eq + 1));
-        const std::vector<std::string> parts = splitDots(key);
+        const std::string key = trimText(set.substr(0, eq));
+        const std::string text = trimText(set.substr(eq + 1));
+        const std::vector<std::string> parts = splitText(key, '.');
         if (parts.empty() || text.empty() ||
             std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); }))
             continue;
@@ -171,7 +139,7 @@ void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) 
         if (head != "cloth" && head != "hair" && head != "collider" && head != "solver") continue;
 
         // The value as TOML, else a comma list of numbers, else a bare string (set_value.h).
-        std::optional<toml::table> parsed = fields::parseSetValue(text, std::string(kSetPrefix) + set);
+        std::optional<toml::table> parsed = parseSetValue(text, std::string(kSetPrefix) + set);
         if (!parsed) {
             setError(set, "cannot read the value '" + text + "'");
             continue;
@@ -228,7 +196,7 @@ void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) 
             }
             target = child->as_table();
             if (!target) {
-                setError(set, "'" + where + "' is " + typeName(*child) + ", not a table");
+                setError(set, "'" + where + "' is " + tomlTypeName(*child) + ", not a table");
                 ok = false;
             }
         }
@@ -252,8 +220,8 @@ void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& all
 }
 
 bool Loader::number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin) {
-    if (!isNumber(n)) {
-        error(n, what + " must be a number, not " + typeName(n));
+    if (!isTomlNumber(n)) {
+        error(n, what + " must be a number, not " + tomlTypeName(n));
         return false;
     }
     const double v = n.value<double>().value_or(0.0);
@@ -279,7 +247,7 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
         v = static_cast<long long>(n.value<double>().value_or(0.0));
     } else {
         error(n, what + " must be a whole number, not " +
-                     (n.is_floating_point() ? std::string("a fraction") : typeName(n)));
+                     (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
         return false;
     }
     if (v < min) {
@@ -292,7 +260,7 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
 
 bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
     if (!n.is_string()) {
-        error(n, what + " must be a string, not " + typeName(n));
+        error(n, what + " must be a string, not " + tomlTypeName(n));
         return false;
     }
     out = n.value<std::string>().value_or("");
@@ -317,7 +285,7 @@ bool Loader::choice(const toml::node& n, const std::string& what, const std::vec
 
 bool Loader::boolean(const toml::node& n, const std::string& what, bool& out) {
     if (!n.is_boolean()) {
-        error(n, what + " must be true or false, not " + typeName(n));
+        error(n, what + " must be true or false, not " + tomlTypeName(n));
         return false;
     }
     out = n.value<bool>().value_or(false);
@@ -330,7 +298,7 @@ bool Loader::numbers(const toml::node& n, const std::string& what, size_t count,
     bool ok = a && a->size() == count;
     if (ok)
         for (const toml::node& e : *a) {
-            if (!isNumber(e) || !std::isfinite(e.value<double>().value_or(NAN))) {
+            if (!isTomlNumber(e) || !std::isfinite(e.value<double>().value_or(NAN))) {
                 ok = false;
                 break;
             }
@@ -351,9 +319,9 @@ std::optional<fields::Param> Loader::param(const toml::node& n, const std::strin
     if (const toml::table* t = n.as_table()) return keyframes(*t, what, width, min);
     if (width == 1) {
         double v = 0.0;
-        if (!isNumber(n)) {
+        if (!isTomlNumber(n)) {
             error(n, what + " must be a number or a keyframed curve { keys = [[t0, v0], [t1, v1]] }, not " +
-                         typeName(n));
+                         tomlTypeName(n));
             return std::nullopt;
         }
         if (!number(n, what, v, min, false)) return std::nullopt;
@@ -387,7 +355,7 @@ std::optional<fields::Param> Loader::keyframes(const toml::table& t, const std::
     std::vector<std::pair<double, std::vector<double>>> list;
     for (const toml::node& k : *keys) {
         const toml::array* pair = k.as_array();
-        if (!pair || pair->size() != 2 || !isNumber(*pair->get(0))) {
+        if (!pair || pair->size() != 2 || !isTomlNumber(*pair->get(0))) {
             error(k, what + ": each key must be [time, value] (time in seconds)");
             ok = false;
             continue;
@@ -479,7 +447,7 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
     const toml::table* t = n.as_table();
     if (!t) {
         error(n, what + " must be a table: { vertices = [...] }, { map = \"pin\" } or "
-                        "{ box = [x0, y0, z0, x1, y1, z1] }, not " + typeName(n));
+                        "{ box = [x0, y0, z0, x1, y1, z1] }, not " + tomlTypeName(n));
         return false;
     }
     checkKeys(*t, {"vertices", "map", "box", "translate"}, what);
@@ -596,7 +564,7 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
         if (const toml::node* o = g->get("origin")) vec3(*o, what + ": grid origin", c.gridOrigin);
         if (const toml::node* a = g->get("axes")) choice(*a, "grid axes", {"xy", "xz", "zy", "yz", "zx", "yx"}, c.gridAxes);
     } else {
-        error(*grid, what + ": grid must be a table { size = [w, h], res = [nx, ny] }, not " + typeName(*grid));
+        error(*grid, what + ": grid must be a table { size = [w, h], res = [nx, ny] }, not " + tomlTypeName(*grid));
     }
     if (const toml::node* n = t.get("density")) number(*n, what + ": density (kg/m²)", c.material.density, 0.0, true);
     auto p = [&](const char* key, fields::Param& out, const std::string& unit) {
@@ -681,7 +649,7 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
             if (vec3(*d, what + ": grid direction", h.direction) && h.direction.norm() == 0.0)
                 error(*d, what + ": grid direction must not be zero");
     } else {
-        error(*grid, what + ": grid must be a table, not " + typeName(*grid));
+        error(*grid, what + ": grid must be a table, not " + tomlTypeName(*grid));
     }
     if (const toml::node* n = t.get("radius")) number(*n, what + ": radius (m)", h.material.radius, 0.0, true);
     if (const toml::node* n = t.get("density")) number(*n, what + ": density (kg/m³)", h.material.density, 0.0, true);
