@@ -197,21 +197,8 @@ void Loader::applySets(toml::table& root) {
                               "gust.NAME.strength or field.NAME.params.PARAM");
             continue;
         }
-        bool ok = true;
-        for (size_t i = next; ok && i + 1 < parts.size(); ++i) {
-            where += "." + parts[i];
-            toml::node* child = target->get(parts[i]);
-            if (!child) {
-                target->insert(parts[i], toml::table{});
-                child = target->get(parts[i]);
-            }
-            target = child->as_table();
-            if (!target) {
-                setError(set, "'" + where + "' is " + tomlTypeName(*child) + ", not a table");
-                ok = false;
-            }
-        }
-        if (ok) target->insert_or_assign(parts.back(), std::move(*doc.get("v")));
+        std::string problem;
+        if (!assignAtPath(*target, parts, next, where, std::move(*doc.get("v")), problem)) setError(set, problem);
     }
 }
 

@@ -67,4 +67,24 @@ std::optional<toml::table> parseSetValue(const std::string& text, const std::str
     return std::nullopt;
 }
 
+bool assignAtPath(toml::table& target, const std::vector<std::string>& parts, size_t first, std::string& where,
+                  toml::node&& value, std::string& error) {
+    toml::table* t = &target;
+    for (size_t i = first; i + 1 < parts.size(); ++i) {
+        where += "." + parts[i];
+        toml::node* child = t->get(parts[i]);
+        if (!child) {
+            t->insert(parts[i], toml::table{});
+            child = t->get(parts[i]);
+        }
+        t = child->as_table();
+        if (!t) {
+            error = "'" + where + "' is " + tomlTypeName(*child) + ", not a table";
+            return false;
+        }
+    }
+    t->insert_or_assign(parts.back(), std::move(value));
+    return true;
+}
+
 } // namespace gale::fields

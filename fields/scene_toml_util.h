@@ -30,4 +30,10 @@ const char* tomlTypeName(const toml::node& n);
 // nullopt when none of those reads. `origin` names the source in toml++'s positions.
 std::optional<toml::table> parseSetValue(const std::string& text, const std::string& origin);
 
+// Sets parts[first .. end−1] below `target` to `value`, making the tables on the way; `where`
+// (the dotted path so far) grows with the walk. False, with `error` set, when a part on the way
+// is not a table.
+bool assignAtPath(toml::table& target, const std::vector<std::string>& parts, size_t first, std::string& where,
+                  toml::node&& value, std::string& error);
+
 } // namespace gale::fields
