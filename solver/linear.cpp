@@ -1,8 +1,6 @@
 // Block-sparse matrix, Baraff–Witkin constraint filter, PCG and LDLᵀ solves (see linear.h).
 #include "solver/linear.h"
 
-#include <Eigen/LU>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -92,12 +90,12 @@ bool Constraints::any() const {
     return false;
 }
 
-Mat3 Constraints::filter(size_t i) const {
-    switch (kind[i]) {
+Mat3 Constraints::filterOf(uint8_t kind, const double* normal) {
+    switch (kind) {
     case 1:
         return Mat3::Zero();
     case 2: {
-        const Vec3 n = vec3At(normal.data(), i);
+        const Vec3 n(normal[0], normal[1], normal[2]);
         return Mat3::Identity() - n * n.transpose();
     }
     default:
@@ -212,15 +210,7 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
             const Mat3 S = c.filter(i);
             d = S * d * S + (Mat3::Identity() - S);
         }
-        Mat3 inv;
-        bool ok = false;
-        double det = 0.0;
-        d.computeInverseAndDetWithCheck(inv, det, ok, 0.0);
-        if (!ok || !inv.allFinite()) {
-            const double dd = std::max(d.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-            inv = Mat3::Identity() / dd;
-        }
-        mPrecond[i] = inv;
+        mPrecond[i] = invertBlockOrScale(d);
     }
     auto precondition = [&](const VecX& r, VecX& out) {
         parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {

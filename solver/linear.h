@@ -93,7 +93,9 @@ struct Constraints {
         z.assign(3 * n, 0.0);
     }
     bool any() const;
-    Mat3 filter(size_t i) const;
+    Mat3 filter(size_t i) const { return filterOf(kind[i], normal.data() + 3 * i); }
+    // S for a filter kind (0, 1, 2) and, for a plane, its normal.
+    static Mat3 filterOf(uint8_t kind, const double* normal);
     // x ← S x in place.
     void apply(double* x) const;
 };

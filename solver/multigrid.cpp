@@ -8,7 +8,6 @@
 #include "solver/linear.h"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -21,30 +20,6 @@ namespace {
 // Blocks are stored column-major, 9 values each (bsr_kernels.h).
 using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
-
-// The inverse of a 3×3 diagonal block; a scaled identity when it is singular.
-void invertBlock(const double* b, double* out) {
-    const Mat3 d = ConstBlockMap(b);
-    Mat3 inv;
-    bool ok = false;
-    double det = 0.0;
-    d.computeInverseAndDetWithCheck(inv, det, ok, 0.0);
-    if (!ok || !inv.allFinite()) {
-        const double dd = std::max(d.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-        inv = Mat3::Identity() / dd;
-    }
-    BlockMap m(out);
-    m = inv;
-}
-
-Mat3 filterOf(uint8_t kind, const double* normal) {
-    if (kind == 1) return Mat3::Zero();
-    if (kind == 2) {
-        const Vec3 n(normal[0], normal[1], normal[2]);
-        return Mat3::Identity() - n * n.transpose();
-    }
-    return Mat3::Identity();
-}
 
 } // namespace
 
@@ -193,7 +168,7 @@ void BlockMultigrid::coarsen(int l) {
         if (!mKind[i]) continue;
         // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
         BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.agg[i]])) -=
-            Mat3::Identity() - filterOf(mKind[i], mNormal.data() + 3 * i);
+            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
     }
     for (int I = 0; I < c.n; ++I) {
         bool any = false;
@@ -202,7 +177,7 @@ void BlockMultigrid::coarsen(int l) {
         Mat3 B = Mat3::Zero();
         for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) {
             const int i = f.members[m];
-            B += filterOf(mKind[i], mNormal.data() + 3 * i);
+            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
         }
         Eigen::SelfAdjointEigenSolver<Mat3> es(B);
         BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
@@ -257,7 +232,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * i + q];
         }
         for (int i : constrained) {
-            const Mat3 S = filterOf(mKind[i], mNormal.data() + 3 * i);
+            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                 BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
                 row = (S * row).eval();
@@ -295,9 +270,9 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         // The inverse of the single-precision diagonal, so that every sweep reads one matrix
         // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
         for (int i = 0; i < L.a.n; ++i) {
-            double d[9];
-            for (int q = 0; q < 9; ++q) d[q] = L.lowVal[9 * static_cast<size_t>(L.a.diag[i]) + q];
-            invertBlock(d, L.dinv.data() + 9 * static_cast<size_t>(i));
+            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+            BlockMap(L.dinv.data() + 9 * static_cast<size_t>(i)) =
+                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
         }
         const size_t n3 = 3 * static_cast<size_t>(L.a.n);
         L.r.resize(n3);
@@ -389,7 +364,7 @@ void BlockMultigrid::cycle(int l) {
             for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
                 const int i = L.members[m];
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i]) t = filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                if (filtered && mKind[i]) t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
@@ -402,7 +377,7 @@ void BlockMultigrid::cycle(int l) {
         for (size_t i = i0; i < i1; ++i) {
             const int I = L.agg[i];
             Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
-            if (filtered && mKind[i]) e = filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
             for (int q = 0; q < 3; ++q) L.x[3 * i + q] += alpha * e[q];
         }
     });

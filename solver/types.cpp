@@ -1,5 +1,10 @@
-// Threading helpers with thread-count-independent results (see types.h).
+// Threading helpers with thread-count-independent results, and the guarded 3×3 block inverse
+// (see types.h).
 #include "solver/types.h"
+
+#include <Eigen/LU>
+
+#include <algorithm>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -17,6 +22,15 @@ void parallelChunks(std::size_t n, std::size_t grain,
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
                       [&](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); });
+}
+
+Mat3 invertBlockOrScale(const Mat3& d) {
+    Mat3 inv;
+    bool ok = false;
+    double det = 0.0;
+    d.computeInverseAndDetWithCheck(inv, det, ok, 0.0);
+    if (!ok || !inv.allFinite()) inv = Mat3::Identity() / std::max(d.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+    return inv;
 }
 
 double deterministicDot(const double* a, const double* b, std::size_t n) {

@@ -29,6 +29,10 @@ inline Eigen::Map<const Vec3> vec3At(const double* p, std::size_t i) {
 void parallelChunks(std::size_t n, std::size_t grain,
                     const std::function<void(std::size_t, std::size_t)>& fn);
 
+// The inverse of a 3×3 block, or I / max|d_ii| when it is singular or its inverse not finite
+// (the fallback of the block-Jacobi and multigrid smoother diagonals).
+Mat3 invertBlockOrScale(const Mat3& d);
+
 // Dot product summed in fixed chunks of kReduceChunk entries, the partial sums added in chunk
 // order: the same bits on 1 or 64 threads.
 constexpr std::size_t kReduceChunk = 3072; // a multiple of 3: chunks hold whole vertices
