@@ -48,11 +48,13 @@ std::string paramJson(const fields::Param& p, double t) {
 const char* solverName(solver::LinearSolverKind k) { return k == solver::LinearSolverKind::Direct ? "direct" : "pcg"; }
 
 std::string stepJson(const solver::StepOptions& s) {
-    return "\"linear_solver\": \"" + std::string(solverName(s.linearSolver)) + "\", \"cg_tolerance\": " +
-           num(s.cgTolerance) + ", \"cg_max_iterations\": " + std::to_string(s.cgMaxIterations) +
+    return "\"linear_solver\": \"" + std::string(solverName(s.linearSolver)) +
+           "\", \"cg_tolerance\": " + num(s.cgTolerance) +
+           ", \"cg_max_iterations\": " + std::to_string(s.cgMaxIterations) +
            ", \"preconditioner\": \"" +
            (s.preconditioner == solver::Preconditioner::Multigrid ? "multigrid" : "jacobi") +
-           "\", \"newton_iterations\": " + std::to_string(s.newtonIterations);
+           "\", \"newton_iterations\": " + std::to_string(s.newtonIterations) +
+           ", \"newton_tolerance\": " + num(s.newtonTolerance);
 }
 
 // The settings as resolved (after --set), for run.json and to check that --resume continues
@@ -119,13 +121,22 @@ std::string frameJson(const solver::FrameStats& f) {
       << ", \"failed\": " << (f.failed ? "true" : "false") << ", \"objects\": [";
     for (size_t i = 0; i < f.bodies.size(); ++i) {
         const solver::BodyFrameStats& b = f.bodies[i];
-        o << (i ? ", " : "") << "{\"name\": " << jsonString(b.name) << ", \"substeps\": " << b.substeps
-          << ", \"rejected_substeps\": " << b.rejected << ", \"deepest_halving\": " << b.deepestHalving
-          << ", \"solver_iterations\": " << b.iterations << ", \"max_iterations\": " << b.maxIterations
-          << ", \"max_residual\": " << num(b.maxResidual) << ", \"max_speed\": " << num(b.maxSpeed)
-          << ", \"max_stretch\": " << num(b.maxStretch) << ", \"energy\": {\"kinetic\": " << num(b.kinetic)
-          << ", \"elastic\": " << num(b.elastic) << ", \"potential\": " << num(b.potential)
-          << ", \"total\": " << num(b.kinetic + b.elastic + b.potential) << "}, \"wind_non_finite\": " << b.windNonFinite
+        o << (i ? ", " : "") << "{\"name\": " << jsonString(b.name)
+          << ", \"substeps\": " << b.substeps << ", \"rejected_substeps\": " << b.rejected
+          << ", \"deepest_halving\": " << b.deepestHalving
+          << ", \"solver_iterations\": " << b.iterations
+          << ", \"max_iterations\": " << b.maxIterations
+          << ", \"max_residual\": " << num(b.maxResidual)
+          << ", \"newton_iterations\": " << b.newtonIterations
+          << ", \"max_newton_iterations\": " << b.maxNewtonIterations
+          << ", \"max_newton_residual\": " << num(b.maxNewtonResidual)
+          << ", \"line_search_cuts\": " << b.lineSearchCuts
+          << ", \"newton_unconverged\": " << b.newtonStalled
+          << ", \"max_speed\": " << num(b.maxSpeed) << ", \"max_stretch\": " << num(b.maxStretch)
+          << ", \"energy\": {\"kinetic\": " << num(b.kinetic) << ", \"elastic\": " << num(b.elastic)
+          << ", \"potential\": " << num(b.potential)
+          << ", \"total\": " << num(b.kinetic + b.elastic + b.potential)
+          << "}, \"wind_non_finite\": " << b.windNonFinite
           << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
           << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";
         for (size_t e = 0; e < b.events.size(); ++e) o << (e ? ", " : "") << jsonString(b.events[e]);

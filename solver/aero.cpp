@@ -155,6 +155,13 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
         double q;
         const double r = std::sqrt(r2);
         const Vec3 e = inPlaneDirection(n, vRel, r, q);
+        // Skew parts (from the exact Jacobians above): ½(J − Jᵀ) = ½k c_w (v nᵀ − n vᵀ) with
+        //   frozen: c_w = C_D − 3 C_L,   smooth-lift: c_w = C_D − 3 C_L s/r,
+        // and (v nᵀ − n vᵀ) x = (n × v) × x.
+        // Kept only where it is comparable to the symmetric damping, |c_w| > ½(C_D + C_L) (the
+        // default C_L = 0.3, C_D = 1 gives 0.1 against 0.65: left out, the solve stays symmetric).
+        const double cw = model == AeroModel::Frozen ? cd - 3.0 * cl : cd - 3.0 * cl * (s / r);
+        if (std::abs(cw) > 0.5 * (cd + cl)) out.skewAxis = 0.5 * k * cw * n.cross(vRel);
         if (model == AeroModel::Frozen) {
             const double iso = k * (cd - cl) * s;
             out.damping = projectPlane(2.0 * k * cd * s, 0.5 * k * (cd + cl) * q, iso, iso, n, e);

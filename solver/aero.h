@@ -25,6 +25,9 @@ enum class AeroJacobian {
 struct AeroResult {
     Vec3 force = Vec3::Zero();
     Mat3 damping = Mat3::Zero();
+    // Axial vector ω of the skew part of ∂F/∂v (N·s/m): ½(J − Jᵀ) x = ω × x. A symmetric solve
+    // cannot hold it; left explicit it makes the linearised step amplify flutter (docs/solver.md).
+    Vec3 skewAxis = Vec3::Zero();
     bool clamped = false; // Paper Jacobian with C_D < C_L: (C_D − C_L) clamped to 0
 };
 

@@ -207,3 +207,35 @@ TEST_CASE("aero: in-plane PSD projection — diagonal, equal-eigenvalue and v �
         CHECK((p - projectByEigen(j)).norm() <= 1e-12 * (1 + j.norm()));
     }
 }
+
+TEST_CASE("aero: the skew axis is the antisymmetric part of the exact Jacobian", "[aero]") {
+    // Against ½(J − Jᵀ) of the exact Jacobian (itself checked by finite differences above),
+    // read as an axial vector: W x = ω × x ⇔ ω = (W₂₁, W₀₂, W₁₀). Kept where |c_w| > ½(C_D + C_L)
+    // (c_w = C_D − 3 C_L frozen, C_D − 3 C_L s/r smooth-lift), zero elsewhere.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int kept = 0, dropped = 0;
+    for (AeroModel model : {AeroModel::Frozen, AeroModel::SmoothLift})
+        for (int trial = 0; trial < 200; ++trial) {
+            const Vec3 v(10 * u(rng), 10 * u(rng), 10 * u(rng));
+            const Vec3 an(0.1 * u(rng), 0.1 * u(rng), 0.1 * u(rng));
+            const double cl = 0.5 + 0.5 * u(rng), cd = 0.5 + 0.5 * u(rng);
+            const AeroResult r = aeroTriangle(v, an, kRho, cl, cd, model, AeroJacobian::Projected);
+            const Mat3 j = aeroTriangleExactJacobian(v, an, kRho, cl, cd, model);
+            const Mat3 w = 0.5 * (j - j.transpose());
+            const Vec3 axis(w(2, 1), w(0, 2), w(1, 0));
+            Vec3 n = an.normalized();
+            if (n.dot(v) < 0) n = -n;
+            const double cw =
+                model == AeroModel::Frozen ? cd - 3 * cl : cd - 3 * cl * n.dot(v) / v.norm();
+            if (std::abs(cw) > 0.5 * (cd + cl)) {
+                ++kept;
+                CHECK((r.skewAxis - axis).norm() <= 1e-10 * (1.0 + axis.norm()));
+            } else {
+                ++dropped;
+                CHECK(r.skewAxis.norm() == 0.0);
+            }
+        }
+    CHECK(kept > 20);
+    CHECK(dropped > 20);
+}

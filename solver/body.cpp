@@ -11,10 +11,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace gale::solver {
 
 namespace {
+// Defect correction of the skew aerodynamic coupling (solveLinear): at most this many extra
+// solves, until the largest change of Δv is below this fraction of Δv's largest entry.
+constexpr int kMaxSkewCorrections = 12;
+constexpr double kSkewTolerance = 1e-3;
 // A vertex this close to a collider's offset surface (m) counts as touching it: rounding
 // after a projection must not switch the contact off.
 constexpr double kContactSlop = 1e-7;
@@ -125,9 +130,10 @@ double Body::maxEdgeStretch() const {
     return m;
 }
 
-void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity) {
+void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity, bool withMatrix) {
     const size_t n = vertexCount();
-    const bool matrix = !mOptions.explicitEuler; // the explicit baseline needs forces only
+    const bool matrix =
+        withMatrix && !mOptions.explicitEuler; // the explicit baseline needs forces only
     if (matrix) mA.setZero();
     mF.setZero(3 * n);
     mKv.setZero(3 * n);
@@ -138,7 +144,11 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity)
     out.f = &mF;
     out.kv = matrix ? &mKv : nullptr;
     out.A = matrix ? &mA : nullptr;
+    out.aero = matrix ? &mAero : nullptr;
+    out.skewed = false;
+    if (matrix) mAero.clear();
     addForces(in, out);
+    if (matrix) mSkewed = out.skewed;
 }
 
 void Body::contactConstraints(const Environment& env, double t, double h) {
@@ -210,6 +220,225 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
     int count = 0;
     for (uint8_t u : touched) count += u;
     return count;
+}
+
+void Body::skewProduct(const VecX& x, VecX& y) const {
+    y.setZero(x.size());
+    for (const AeroCoupling& c : mAero) {
+        if (c.v[0] < 0) continue;
+        Vec3 sum = Vec3::Zero();
+        for (int k = 0; k < 3; ++k)
+            if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
+        const Vec3 w = c.axis.cross(sum);
+        for (int k = 0; k < 3; ++k)
+            if (c.v[k] >= 0) y.segment<3>(3 * c.v[k]) += w;
+    }
+}
+
+double Body::aeroQuadratic(const VecX& x) const {
+    double q = 0.0;
+    for (const AeroCoupling& c : mAero) {
+        if (c.v[0] < 0) continue;
+        Vec3 sum = Vec3::Zero();
+        for (int k = 0; k < 3; ++k)
+            if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
+        q += sum.dot(c.damping * sum); // Σ_c x_cᵀ D s = sᵀ D s
+    }
+    return q;
+}
+
+// (H + B) Δv = b with H the assembled SPD matrix and B the skew part of the aerodynamic
+// Jacobian (mAero), by defect correction: H Δv_{j+1} = b − B Δv_j, each solve filtered and
+// warm-started. Converges when the spectral radius of H⁻¹B is below one (B is skew, H ≥ M).
+SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
+    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver,
+                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
+    if (!mSkewed || !ls.converged || ls.failed) return ls;
+    const VecX dvSym = dv; // the symmetric solve: kept when the correction does not contract
+    VecX bd, prev;
+    double lastChange = 0.0;
+    for (int j = 0; j < kMaxSkewCorrections; ++j) {
+        skewProduct(dv, bd);
+        bd = b - bd;
+        prev = dv;
+        const SolveStatus s2 = mSolver.solve(mA, mConstraints, bd, dv, mOptions.linearSolver,
+                                             mOptions.cgTolerance, mOptions.cgMaxIterations);
+        ls.iterations += s2.iterations;
+        ls.residual = std::max(ls.residual, s2.residual);
+        const double change = (dv - prev).lpNorm<Eigen::Infinity>(),
+                     size = dv.lpNorm<Eigen::Infinity>();
+        // Contraction ratio ‖H⁻¹B‖ estimated from successive changes: at 0.9 and above (strong
+        // skew against little mass and damping, e.g. a cloth stretched far beyond its rest
+        // area) the correction is dropped and the step keeps the symmetric solve.
+        const bool diverging = !s2.converged || s2.failed || !std::isfinite(change) ||
+                               (j == 0 ? change > size : change > 0.9 * lastChange);
+        if (diverging) {
+            dv = dvSym;
+            ++ls.skewFallbacks;
+            break;
+        }
+        lastChange = change;
+        if (change <= kSkewTolerance * size) break;
+    }
+    return ls;
+}
+
+double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h, ForceInput& in,
+                        ForceOutput& out, const Vec3& gravity, bool withMatrix) {
+    const size_t n = vertexCount();
+    mV = v0 + dv;
+    mX = x0 + h * mV;
+    in.x = mX.data();
+    in.v = mV.data();
+    assemble(in, out, gravity, withMatrix);
+    mG.resize(3 * n);
+    double rInf = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        Vec3 g = mMass[i] * dv.segment<3>(3 * i) - h * mF.segment<3>(3 * i);
+        const uint8_t kind = mConstraints.kind[i];
+        if (kind == 1) {
+            g.setZero();
+        } else if (kind == 2) {
+            const Vec3 nn = vec3At(mConstraints.normal.data(), i);
+            g -= g.dot(nn) * nn;
+        }
+        mG.segment<3>(3 * i) = g;
+        const double e = (mDiagInv[i] * g).norm(); // m/s
+        if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();
+        rInf = std::max(rInf, e);
+    }
+    return rInf;
+}
+
+double Body::elasticAt(const VecX& x, double t, VecX& fEl) {
+    fEl.setZero(x.size());
+    mZero.setZero(x.size());
+    ForceInput in;
+    in.x = x.data();
+    in.v = mZero.data(); // no velocity: no damping; no wind: no aerodynamics
+    in.t = t;
+    ForceOutput out;
+    out.f = &fEl;
+    addForces(in, out);
+    return out.elasticEnergy;
+}
+
+// Newton on the backward-Euler equations in the velocity change Δv = v₁ − v₀ (x₁ = x₀ + h v₁):
+//   g(Δv) = M Δv − h f(x₀ + h v₁, v₁) = 0,   filtered by the constraints (S g = 0).
+// The first iterate is the linearised solve already in mDv (Baraff & Witkin 1998). Converged when
+// every free vertex's velocity error eᵢ = Aᵢᵢ⁻¹ S gᵢ (block-Jacobi estimate, Aᵢᵢ the diagonal
+// blocks of A at the substep's start; m/s) is below `newtonTolerance`.
+// Otherwise each iteration k solves A_k δ = −g_k, A_k = M + hD + h²K at the iterate (SPD: the
+// projected aerodynamic damping, the Gauss–Newton membrane), and takes the longest step
+// α ∈ {1, ½, ¼, …} with Armijo's decrease of the incremental potential (Gast et al. 2015) in
+// which the non-conservative forces (aerodynamics, Rayleigh damping) are frozen at the iterate:
+//   Φ_k(Δv) = ½ Δvᵀ M Δv + E(x₀ + h(v₀ + Δv)) − h G_kᵀ Δv,   G_k = f_k − f_E(x_k)
+// (E the elastic energy, f_E = −∇E; gravity is in G_k). ∇Φ_k(Δv_k) = g_k, so δ is a descent
+// direction of Φ_k for any SPD A_k, and a step that would over-stretch an edge raises E and is
+// cut. A fixed point of the iteration solves the nonlinear equations exactly, aerodynamics
+// included. The linearised iterate is checked against Δv = 0 with Φ₀ (forces frozen at x₀, v₀).
+void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
+                  const VecX& v0, double h, SubstepStatus& st) {
+    constexpr double kArmijo = 1e-4;
+    constexpr int kMaxCuts = 10;
+    const size_t n = vertexCount();
+    const double t1 = in.t;
+    mDiagInv.resize(n);
+    for (size_t i = 0; i < n; ++i)
+        mDiagInv[i] = invertBlockOrScale(mA.block(mA.diagonalSlot(static_cast<int>(i))));
+    mF0 = mF; // f(x₀, v₀)
+    double rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+    st.newtonResidual = rInf;
+    if (rInf <= mOptions.newtonTolerance) return;
+
+    // Φ along Δv = α d from base Δv_b: inertia exact, E exact, frozen forces G linear.
+    auto inertia = [&](const VecX& dv) {
+        double e = 0.0;
+        for (size_t i = 0; i < n; ++i) e += 0.5 * mMass[i] * dv.segment<3>(3 * i).squaredNorm();
+        return e;
+    };
+    // The aerodynamic force frozen at the base Δv_b decreases as the cloth follows the air: its
+    // symmetric damping enters Φ as ½ (Δv − Δv_b)ᵀ hD (Δv − Δv_b) (PSD), so that the line search
+    // does not take the frozen force for a constant one.
+    auto phi = [&](const VecX& dv, double energy, const VecX& base) {
+        return inertia(dv) + energy - h * mGk.dot(dv) + 0.5 * aeroQuadratic(dv - base);
+    };
+
+    // The linearised step against Δv = 0, with G₀ = f(x₀, v₀) − f_E(x₀).
+    const VecX dvLin = mDv;
+    elasticAt(x0, t1, mFel);
+    mGk = mF0 - mFel;
+    VecX trialX = x0 + h * v0;
+    double energy = elasticAt(trialX, t1, mFel);
+    VecX dvBase = VecX::Zero(3 * n);
+    const double phi0 = phi(dvBase, energy, dvBase);
+    double slope = -h * (mFel + mGk).dot(dvLin); // ∇Φ₀(0)·d
+    double alpha = 1.0, phiTrial = 0.0;
+    VecX fElTrial;
+    int cuts = 0;
+    for (;; ++cuts) {
+        mDv = alpha * dvLin;
+        trialX = x0 + h * (v0 + mDv);
+        const double eTrial = elasticAt(trialX, t1, fElTrial);
+        phiTrial = phi(mDv, eTrial, dvBase);
+        const bool ok = slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
+        if (ok && std::isfinite(phiTrial)) {
+            energy = eTrial;
+            mFel = fElTrial;
+            break;
+        }
+        if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
+            mDv = dvBase;
+            elasticAt(x0 + h * v0, t1, mFel);
+            energy = elasticAt(x0 + h * v0, t1, mFel);
+            break;
+        }
+        alpha *= 0.5;
+    }
+    st.lineSearchCuts += cuts;
+
+    VecX rhs(3 * n), delta(3 * n);
+    std::fill(mConstraints.z.begin(), mConstraints.z.end(), 0.0);
+    for (int k = 0;; ++k) {
+        // f_k and A_k at the iterate; g_k; G_k = f_k − f_E(x_k) (f_E from the accepted trial).
+        rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, k < mOptions.newtonIterations);
+        if (rInf <= mOptions.newtonTolerance || k == mOptions.newtonIterations ||
+            !std::isfinite(rInf))
+            break;
+        mGk = mF - mFel;
+        rhs = -mG;
+        delta.setZero();
+        const SolveStatus ns = solveLinear(rhs, delta);
+        st.iterations += ns.iterations;
+        st.residual = std::max(st.residual, ns.residual);
+        ++st.newtonIterations;
+        if (ns.failed || !delta.allFinite()) break;
+        dvBase = mDv;
+        const double phiBase = phi(dvBase, energy, dvBase);
+        slope = mG.dot(delta);
+        alpha = 1.0;
+        bool accepted = false;
+        for (cuts = 0; cuts <= kMaxCuts; ++cuts, alpha *= 0.5) {
+            mDv = dvBase + alpha * delta;
+            trialX = x0 + h * (v0 + mDv);
+            const double eTrial = elasticAt(trialX, t1, fElTrial);
+            phiTrial = phi(mDv, eTrial, dvBase);
+            if (std::isfinite(phiTrial) &&
+                phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0)) {
+                energy = eTrial;
+                mFel = fElTrial;
+                accepted = true;
+                break;
+            }
+        }
+        st.lineSearchCuts += std::min(cuts, kMaxCuts);
+        if (!accepted) { // no decrease along δ (rounding at convergence): stay
+            mDv = dvBase;
+            rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+            break;
+        }
+    }
+    st.newtonResidual = rInf;
 }
 
 SubstepStatus Body::substep(const Environment& env, double t, double h) {
@@ -302,33 +531,15 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     else
         mDv.setZero(3 * n);
     mSolver.setPreconditioner(mOptions.preconditioner);
-    ls = mSolver.solve(mA, mConstraints, mB, mDv, mOptions.linearSolver, mOptions.cgTolerance,
-                       mOptions.cgMaxIterations);
+    ls = solveLinear(mB, mDv);
     }
     st.iterations = ls.iterations;
     st.residual = ls.residual;
     st.converged = ls.converged && !ls.failed;
 
-    // 5. Optional Newton iterations on the backward-Euler residual.
-    for (int k = 0; k < mOptions.newtonIterations && st.converged && !mOptions.explicitEuler; ++k) {
-        mV = v0 + mDv;
-        mX = x0 + h * mV;
-        in.x = mX.data();
-        in.v = mV.data();
-        assemble(in, out, env.gravity);
-        VecX rhs(3 * n);
-        for (size_t i = 0; i < n; ++i)
-            rhs.segment<3>(3 * i) =
-                h * mF.segment<3>(3 * i) - mMass[i] * (mV.segment<3>(3 * i) - v0.segment<3>(3 * i));
-        std::fill(mConstraints.z.begin(), mConstraints.z.end(), 0.0);
-        VecX delta = VecX::Zero(3 * n);
-        SolveStatus ns = mSolver.solve(mA, mConstraints, rhs, delta, mOptions.linearSolver,
-                                       mOptions.cgTolerance, mOptions.cgMaxIterations);
-        st.iterations += ns.iterations;
-        st.residual = std::max(st.residual, ns.residual);
-        st.converged = ns.converged && !ns.failed;
-        mDv += delta;
-    }
+    // 5. Newton on the backward-Euler residual, from the linearised solve as the first iterate.
+    if (st.converged && !mOptions.explicitEuler && mOptions.newtonIterations > 0)
+        newton(env, in, out, x0, v0, h, st);
     mDvGuess = mDv;
     mHGuess = h;
     mV = v0 + mDv;

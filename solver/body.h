@@ -41,7 +41,12 @@ struct StepOptions {
     Preconditioner preconditioner = Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
     double cgTolerance = 1e-3;  // relative residual of the filtered system
     int cgMaxIterations = 2000;
-    int newtonIterations = 0;   // extra Newton iterations on the backward-Euler residual
+    // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):
+    // at most `newtonIterations` corrections, until every free vertex's velocity residual
+    // error Aᵢᵢ⁻¹ S gᵢ is below
+    // `newtonTolerance` (m/s).
+    int newtonIterations = 0;
+    double newtonTolerance = 0.01;
     bool warmStart = true;      // start CG from the previous substep's Δv
     // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
     // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
@@ -69,6 +74,10 @@ struct SubstepStatus {
     int iterations = 0;       // linear-solver iterations (all Newton iterations)
     double residual = 0.0;    // the largest relative residual of those solves
     bool converged = true;
+    int newtonIterations = 0;    // Newton corrections after the linearised solve
+    double newtonResidual = 0.0; // m/s: the largest free vertex's velocity residual at the end
+    int lineSearchCuts = 0;      // step halvings of the Newton line search
+    bool newtonStalled = false;  // stopped above the tolerance: no step lowered the merit
     size_t windNonFinite = 0; // wind samples that came back NaN/inf (replaced by zero)
     std::string windMessage;
     int clampedJacobians = 0; // paper Jacobian with C_D < C_L, clamped
@@ -81,6 +90,15 @@ struct SubstepStatus {
 struct TroubleLimits {
     double overStretch = 3.0;   // edge length / rest length that counts as over-stretched
     double velocityJump = 50.0; // m/s: a |Δv| larger than this and than 2× the speed scale
+};
+
+// One element's aerodynamic linearisation (ForceOutput::aero); unused corners are −1. With
+// s = Σ_{c in element} x_c, every corner c gets (A x)_c += damping s + axis × s: `damping` the
+// symmetric part (already in A), `axis` the skew part (a cloth triangle: (h/9) D and (h/9) ω).
+struct AeroCoupling {
+    std::array<int, 3> v{-1, -1, -1};
+    Mat3 damping = Mat3::Zero();
+    Vec3 axis = Vec3::Zero();
 };
 
 // What a body's force routine reads and writes.
@@ -98,6 +116,9 @@ struct ForceOutput {
     BlockMatrix* A = nullptr;   // h·D + h²·K accumulated (null: forces only)
     double elasticEnergy = 0.0; // J
     int clamped = 0;
+    // The aerodynamic linearisation per element when asked for (one slot each; empty: none).
+    std::vector<AeroCoupling>* aero = nullptr;
+    bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
 };
 
 class Body {
@@ -165,7 +186,22 @@ protected:
 private:
     void contactConstraints(const Environment& env, double t, double h);
     int resolveContacts(const Environment& env, double t1, double h);
-    void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity);
+    void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
+                  bool withMatrix = true);
+    // The filtered backward-Euler residual g at Δv into mG (mX, mV, mF, and A when asked, left
+    // there); returns max |Aᵢᵢ⁻¹ S gᵢ| (m/s), infinite when not finite.
+    double residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h, ForceInput& in,
+                      ForceOutput& out, const Vec3& gravity, bool withMatrix);
+    // y = B x, B the skew part of the couplings in mAero; aeroQuadratic: xᵀ D x of their
+    // symmetric part.
+    void skewProduct(const VecX& x, VecX& y) const;
+    double aeroQuadratic(const VecX& x) const;
+    // The linear solve of the step with the assembled matrix and the skew couplings.
+    SolveStatus solveLinear(const VecX& b, VecX& dv);
+    // Elastic energy (J) and conservative elastic forces f_E = −∇E (N) at positions x.
+    double elasticAt(const VecX& x, double t, VecX& fEl);
+    void newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
+                const VecX& v0, double h, SubstepStatus& st);
 
     std::vector<int> mPinned;             // vertex per pin
     std::vector<int> mPinSet;             // index into mPinSets per pin
@@ -179,7 +215,10 @@ private:
     Constraints mConstraints;
     std::vector<double> mContactImpulse;  // per vertex: suppressed normal speed (m/s)
     std::vector<int> mContactCollider;    // per vertex: collider holding it in the solve, or -1
-    VecX mWind, mF, mKv, mDv, mDvGuess, mB;
+    VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
+    std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
+    bool mSkewed = false;            // ... with a skew part somewhere
+    std::vector<Mat3> mDiagInv;      // Newton's residual weights (body.cpp, newton())
     double mHGuess = 0.0;
 };
 

@@ -137,6 +137,8 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // Per triangle: membrane (stretch + shear) with Rayleigh damping f = −βKv, and the
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
+    if (out.aero) out.aero->assign(aeroMatrix ? nt : 0, AeroCoupling{}); // one slot per triangle
+    bool skewed = false; // any triangle with a skew part
     MembraneFactors m;
     const Mat3 zero = Mat3::Zero();
     double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
@@ -162,6 +164,9 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
             if (aeroMatrix) {
                 hD9 = (h / 9.0) * r.damping;
                 withD = true;
+                if (out.aero)
+                    (*out.aero)[e] = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
+                skewed = skewed || r.skewAxis.squaredNorm() > 0.0;
             }
         }
         const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
@@ -183,6 +188,7 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
             addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK, withD ? hD9 : zero);
     }
     out.clamped += clamped;
+    out.skewed = out.skewed || skewed;
 
     // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale.
     if (kb != 0.0) {

@@ -105,6 +105,7 @@ struct SolveStatus {
     int iterations = 0;
     double residual = 0.0; // ‖Â y − r‖ / ‖r‖ of the filtered system
     bool failed = false;   // a factorisation failed or a value became non-finite
+    int skewFallbacks = 0; // skew aerodynamic corrections dropped (Body::solveLinear)
 };
 
 enum class LinearSolverKind { Pcg, Direct };

@@ -36,14 +36,45 @@ constexpr std::string_view kSetPrefix = "--set ";
 // implicit solver minutes a frame and gigabytes).
 constexpr long long kMaxGridVertices = 1LL << 20;
 
-const std::vector<std::string> kClothKeys = {
-    "name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift", "drag",
-    "aero_model", "aero_jacobian", "pins", "linear_solver", "preconditioner", "cg_tolerance",
-    "cg_max_iterations", "newton_iterations", "output"};
-const std::vector<std::string> kHairKeys = {
-    "name", "strands", "grid", "radius", "density", "stretch", "bend", "damping", "drag_normal",
-    "drag_tangent", "root_pinned", "pins", "linear_solver", "preconditioner", "cg_tolerance",
-    "cg_max_iterations", "newton_iterations", "output"};
+const std::vector<std::string> kClothKeys = {"name",
+                                             "mesh",
+                                             "grid",
+                                             "density",
+                                             "stretch",
+                                             "shear",
+                                             "bend",
+                                             "damping",
+                                             "lift",
+                                             "drag",
+                                             "aero_model",
+                                             "aero_jacobian",
+                                             "pins",
+                                             "linear_solver",
+                                             "preconditioner",
+                                             "cg_tolerance",
+                                             "cg_max_iterations",
+                                             "newton_iterations",
+                                             "newton_tolerance",
+                                             "output"};
+const std::vector<std::string> kHairKeys = {"name",
+                                            "strands",
+                                            "grid",
+                                            "radius",
+                                            "density",
+                                            "stretch",
+                                            "bend",
+                                            "damping",
+                                            "drag_normal",
+                                            "drag_tangent",
+                                            "root_pinned",
+                                            "pins",
+                                            "linear_solver",
+                                            "preconditioner",
+                                            "cg_tolerance",
+                                            "cg_max_iterations",
+                                            "newton_iterations",
+                                            "newton_tolerance",
+                                            "output"};
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
@@ -497,8 +528,11 @@ void Loader::stepOptions(const toml::table& t, const std::string& what, StepOpti
     }
     if (const toml::node* n = t.get("newton_iterations")) {
         long long v = 0;
-        if (integer(*n, what + ": newton_iterations", v, 0)) s.newtonIterations = static_cast<int>(std::min(v, 20LL));
+        if (integer(*n, what + ": newton_iterations", v, 0))
+            s.newtonIterations = static_cast<int>(std::min(v, 50LL));
     }
+    if (const toml::node* n = t.get("newton_tolerance"))
+        number(*n, what + ": newton_tolerance", s.newtonTolerance, 0.0, true);
     if (const toml::node* n = t.get("output")) choice(*n, "output format", {"obj", "ply"}, output);
 }
 

@@ -75,6 +75,9 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
         stats.maxIterations = std::max(stats.maxIterations, st.iterations);
         stats.maxResidual = std::max(stats.maxResidual, st.residual);
         stats.clampedJacobians += st.clampedJacobians;
+        stats.newtonIterations += st.newtonIterations;
+        stats.maxNewtonIterations = std::max(stats.maxNewtonIterations, st.newtonIterations);
+        stats.lineSearchCuts += st.lineSearchCuts;
         if (st.windNonFinite) {
             if (stats.windNonFinite == 0) {
                 std::snprintf(buf, sizeof buf, "t=%.6g s: wind: %s", t, st.windMessage.c_str());
@@ -106,6 +109,8 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
                           t, troubleName(st.trouble), st.reason.c_str(), h);
             stats.events.push_back(buf);
         }
+        stats.maxNewtonResidual = std::max(stats.maxNewtonResidual, st.newtonResidual);
+        if (st.newtonResidual > body.options().newtonTolerance) ++stats.newtonStalled;
         tick += ticksPerBase >> level;
         stats.contacts = st.contacts;
         ++stats.substeps;

@@ -31,6 +31,11 @@ struct BodyFrameStats {
     long iterations = 0;     // linear-solver iterations, summed over substeps
     int maxIterations = 0;   // the most in one substep
     double maxResidual = 0.0;
+    int newtonIterations = 0;       // Newton corrections after the linearised solves, summed
+    int maxNewtonIterations = 0;    // the most in one substep
+    double maxNewtonResidual = 0.0; // m/s: the largest velocity residual a substep ended with
+    int lineSearchCuts = 0;         // Newton line-search halvings, summed
+    int newtonStalled = 0;          // substeps that ended above newton_tolerance
     double maxSpeed = 0.0;   // m/s at the end of the frame
     double maxStretch = 0.0; // edge length / rest length at the end of the frame
     double kinetic = 0.0, elastic = 0.0, potential = 0.0; // J, end of frame
