@@ -148,7 +148,9 @@ template <class T> struct Fit {
 };
 template <class T> struct Gamma { static T apply(T x, T g) { return std::pow(x, 1 / g); } };
 template <class T> struct Bias { static T apply(T x, T b) { return bias(x, b); } };
-// SeExpr2's contrast: note that it biases (1 - c) by 2x, in that argument order.
+// SeExpr2's contrast: note that it biases (1 - c) by 2x, in that argument order. So x outside
+// [0, 1] takes the log of a negative number and gives NaN (pow(1, NaN) = 1 when c = 0); kept
+// on purpose, for SeExpr2's numbers.
 template <class T> struct Contrast {
     static T apply(T x, T c) {
         if (x < T(0.5)) return T(0.5) * bias(1 - c, 2 * x);
@@ -242,8 +244,10 @@ void addMathBuiltins(FunctionTable& t) {
                            "linearly remaps x in [a1, b1] to [a2, b2] (no clamping)"));
     t.add(mapBuiltin2<Gamma>("gamma", "FP[n] gamma(FP[n] x, FP[n] g)", "gamma correction: x^(1/g)"));
     t.add(mapBuiltin2<Bias>("bias", "FP[n] bias(FP[n] x, FP[n] b)", "x^(log b / log 0.5): b < 0.5 pulls down, b > 0.5 up"));
-    t.add(mapBuiltin2<Contrast>("contrast", "FP[n] contrast(FP[n] x, FP[n] c)",
-                                "contrast around 0.5: c < 0.5 decreases it, c > 0.5 increases it"));
+    t.add(mapBuiltin2<Contrast>(
+        "contrast", "FP[n] contrast(FP[n] x, FP[n] c)",
+        "contrast around 0.5: c < 0.5 decreases it, c > 0.5 increases it; x outside [0, 1] "
+        "gives NaN (0.5 if c = 0), as in SeExpr2"));
     t.add(mapBuiltin2<Boxstep>("boxstep", "FP[n] boxstep(FP[n] x, FP[n] a)", "0 if x < a, else 1"));
     t.add(mapBuiltin3<Linearstep>("linearstep", "FP[n] linearstep(FP[n] x, FP[n] a, FP[n] b)",
                                   "0 below a, 1 above b, linear between (a > b reverses)"));
