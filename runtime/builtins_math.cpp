@@ -1,5 +1,6 @@
 // Scalar math and remapping built-ins (SeExpr2's formulas, evaluation order included), applied
-// per component over FP[n]. The vector and selection families are registered from here too.
+// per component over FP[n]. The vector, selection and colour families are registered from here
+// too.
 #include "runtime/builtins.h"
 #include "runtime/builtins_detail.h"
 #include "runtime/fastmath.h"
@@ -188,6 +189,10 @@ template <class T> struct Mix { static T apply(T a, T b, T alpha) { return a * (
 
 } // namespace
 
+double detail::remapValue(double x, double source, double range, double falloff, double interp) {
+    return Remap<double>::apply(x, source, range, falloff, interp);
+}
+
 void addMathBuiltins(FunctionTable& t) {
     // C math
     t.add(mapBuiltin1<Abs>("abs", "FP[n] abs(FP[n] x)", "absolute value"));
@@ -261,6 +266,7 @@ void addMathBuiltins(FunctionTable& t) {
 
     detail::addVectorBuiltins(t);
     detail::addSelectionBuiltins(t);
+    detail::addColorBuiltins(t);
 }
 
 } // namespace gale::runtime
