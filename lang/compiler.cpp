@@ -628,7 +628,7 @@ Value Compiler::callBuiltin(const Expr* e, const FunctionInfo& fn, int32_t index
             } else {
                 groupWidth = w;
             }
-        } else if (t.width != p.width && t.width != 1) {
+        } else if (t.width != p.width && t.width != 1 && !(p.width == 1 && fn.firstComponent)) {
             Diagnostic* d = error(spans[i], "argument " + std::to_string(i + 1) + " ('" + p.name + "') of '" + e->text +
                                                 "' must be FP[" + std::to_string(p.width) + "], not " + typeName(t) +
                                                 ": vector widths differ");
@@ -641,6 +641,9 @@ Value Compiler::callBuiltin(const Expr* e, const FunctionInfo& fn, int32_t index
     for (size_t i = 0; i < args.size(); ++i) {
         const ParamSpec& p = sig.params[std::min(i, nParams - 1)];
         if (p.kind == ParamSpec::Float && p.width > 1) args[i] = splat(args[i], p.width, spans[i]);
+        else if (p.kind == ParamSpec::Float && p.width == 1 && fn.firstComponent &&
+                 args[i].type.width > 1)
+            args[i] = component(args[i], 0, spans[i]);
         if (!args[i].ok()) return {};
         l = combine(l, args[i].type.lifetime);
         site.argTypes.push_back(args[i].type);

@@ -60,6 +60,10 @@ struct FunctionInfo {
     bool foldable = true;       // pure: may be folded when its arguments are constant, and
                                 // hoisted (run once per batch) when they are uniform
     bool sideEffects = false;   // printf: never folded or hoisted, runs only on active lanes
+    // SeExpr2's scalar-parameter rule for its ramp and colour built-ins (curve, ccurve, hsi,
+    // midhsi, saturate, rotate): a vector passed to a fixed FP[1] parameter gives its first
+    // component, instead of a width error.
+    bool firstComponent = false;
     // Optional extra validation after the signature matched; reports to site.sink and
     // returns false on error; may set site.resultType.
     bool (*validate)(CallSite& site) = nullptr;

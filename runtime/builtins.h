@@ -82,7 +82,8 @@ private:
 };
 
 // Registration functions, one per source file of built-ins (each appends to the table).
-void addMathBuiltins(FunctionTable& t);   // builtins_math.cpp: math, remap, vector, selection
+void addMathBuiltins(FunctionTable& t);   // builtins_math.cpp: math, remap, vector, selection,
+                                          // colour
 void addCurveBuiltins(FunctionTable& t);  // builtins_curve.cpp: spline, curve, ccurve
 void addStringBuiltins(FunctionTable& t); // builtins_string.cpp: sprintf, printf (getVar is
                                           // compiled by the compiler itself)

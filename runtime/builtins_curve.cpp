@@ -227,7 +227,9 @@ struct CurveK {
     }
 };
 
-// (n - 1) % 3 == 0, value widths, and constant interpolation codes in 0..4.
+// (n - 1) % 3 == 0, value widths, and constant interpolation codes in 0..4. As in SeExpr2, a
+// vector position or interpolation code gives its first component (curve's FP[1] parameters are
+// reduced by the compiler already, ccurve's reach here as ANY).
 bool validateCurveArgs(lang::CallSite& site, int valueWidth) {
     const size_t nargs = site.argTypes.size();
     const std::string name(site.name);
@@ -245,11 +247,13 @@ bool validateCurveArgs(lang::CallSite& site, int valueWidth) {
         }
         const bool isValue = (j - 1) % 3 == 1;
         const int allowed = isValue ? valueWidth : 1;
-        if (!t.isFloat() || (t.width != 1 && t.width != allowed)) {
+        if (!t.isFloat() || (isValue && t.width != 1 && t.width != allowed)) {
             const char* what = isValue ? "value" : ((j - 1) % 3 == 0 ? "position" : "interpolation code");
-            site.sink->error(site.argSpans[j], name + ": a control point's " + what + " must be " +
-                                                   (allowed == 1 ? "FP[1]" : "FP[1] or FP[3]") + ", got " +
-                                                   lang::typeName(t));
+            site.sink->error(
+                site.argSpans[j],
+                name + ": a control point's " + what + " must be " +
+                    (!isValue ? "a number" : (allowed == 1 ? "FP[1]" : "FP[1] or FP[3]")) +
+                    ", got " + lang::typeName(t));
             ok = false;
             continue;
         }
@@ -274,15 +278,21 @@ bool validateCcurve(lang::CallSite& site) { return validateCurveArgs(site, 3); }
 void addCurveBuiltins(FunctionTable& t) {
     t.add(kernelBuiltin<SplineK>("spline", "FP[n] spline(FP[n] u, FP[n] y1, FP[n] y2, FP[n] y3, FP[n] y4, FP[n] more...)",
                                  "uniform Catmull-Rom through y2..y(n-1) for u in [0, 1]; y1, yn shape the ends"));
-    Builtin curve = kernelBuiltin<CurveK<1>>(
-        "curve", "FP[1] curve(FP[1] param, FP[1] posValInterp...)",
-        "ramp through control points (pos, val, interp); interp 0 none, 1 linear, 2 smooth, 3 spline, 4 monotone");
+    Builtin curve =
+        kernelBuiltin<CurveK<1>>("curve", "FP[1] curve(FP[1] param, FP[1] posValInterp...)",
+                                 "ramp through control points (pos, val, interp); interp 0 none, 1 "
+                                 "linear, 2 smooth, 3 spline, 4 monotone; "
+                                 "a vector argument gives its first component (SeExpr2)");
     curve.info.validate = &validateCurve;
+    curve.info.firstComponent = true;
     t.add(curve);
-    Builtin ccurve = kernelBuiltin<CurveK<3>>(
-        "ccurve", "FP[3] ccurve(FP[1] param, ANY posValInterp...)",
-        "curve() with FP[3] values (a scalar value is broadcast): triples (pos, FP[3] val, interp)");
+    Builtin ccurve =
+        kernelBuiltin<CurveK<3>>("ccurve", "FP[3] ccurve(FP[1] param, ANY posValInterp...)",
+                                 "curve() with FP[3] values (a scalar value is broadcast): triples "
+                                 "(pos, FP[3] val, interp); a vector param, "
+                                 "pos or interp gives its first component (SeExpr2)");
     ccurve.info.validate = &validateCcurve;
+    ccurve.info.firstComponent = true;
     t.add(ccurve);
 }
 

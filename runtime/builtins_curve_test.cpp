@@ -205,19 +205,30 @@ TEST_CASE("curve and ccurve validate their argument shapes and codes", "[builtin
         CHECK(!s.validate());
     }
     {
-        // ccurve: FP[3] or FP[1] values; positions and codes must be scalars.
+        // ccurve: FP[3] or FP[1] values; a vector position or code gives its first component
+        // (SeExpr2), a string is an error.
         std::vector<lang::Type> t = scalars(7);
         t[2] = lang::Type::fp(3);
         Site ok("ccurve", t, {});
         CHECK(ok.validate());
         t[4] = lang::Type::fp(3);
+        t[6] = lang::Type::fp(2);
+        Site vecPos("ccurve", t, {{}, {}, {}, {}, {}, {}, {1, 9}});
+        CHECK(vecPos.validate());
+        CHECK(!vecPos.sink.hasErrors());
+        Site badCode("ccurve", t, {{}, {}, {}, {}, {}, {}, {7, 1}});
+        CHECK(!badCode.validate()); // the code is the first component: 7
+        t[4] = lang::Type::string(lang::Lifetime::Constant);
         Site bad("ccurve", t, {});
         CHECK(!bad.validate());
+        REQUIRE(bad.sink.errorCount() == 1);
         CHECK(bad.sink.diagnostics()[0].span.begin == bad.site.argSpans[4].begin);
         t[4] = lang::Type::fp(1);
         t[5] = lang::Type::fp(2);
         Site bad2("ccurve", t, {});
         CHECK(!bad2.validate());
+        REQUIRE(bad2.sink.errorCount() == 1);
+        CHECK(bad2.sink.diagnostics()[0].span.begin == bad2.site.argSpans[5].begin);
     }
 }
 

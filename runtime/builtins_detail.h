@@ -9,9 +9,14 @@
 
 namespace gale::runtime::detail {
 
-// Registered by addMathBuiltins (builtins_vector.cpp, builtins_select.cpp).
+// Registered by addMathBuiltins (builtins_vector.cpp, builtins_select.cpp, builtins_color.cpp).
 void addVectorBuiltins(FunctionTable& t);
 void addSelectionBuiltins(FunctionTable& t);
+void addColorBuiltins(FunctionTable& t);
+
+// SeExpr2's remap(x, source, range, falloff, interp) in double (builtins_math.cpp); midhsi
+// shapes its map with it.
+double remapValue(double x, double source, double range, double falloff, double interp);
 
 // C's float-to-int truncation as SeExpr2 performs it on x86-64 (`int(x)`), without undefined
 // behaviour: NaN and values outside int's range give INT_MIN, like cvttsd2si.

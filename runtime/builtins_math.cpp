@@ -1,5 +1,6 @@
 // Scalar math and remapping built-ins (SeExpr2's formulas, evaluation order included), applied
-// per component over FP[n]. The vector and selection families are registered from here too.
+// per component over FP[n]. The vector, selection and colour families are registered from here
+// too.
 #include "runtime/builtins.h"
 #include "runtime/builtins_detail.h"
 #include "runtime/fastmath.h"
@@ -148,7 +149,9 @@ template <class T> struct Fit {
 };
 template <class T> struct Gamma { static T apply(T x, T g) { return std::pow(x, 1 / g); } };
 template <class T> struct Bias { static T apply(T x, T b) { return bias(x, b); } };
-// SeExpr2's contrast: note that it biases (1 - c) by 2x, in that argument order.
+// SeExpr2's contrast: note that it biases (1 - c) by 2x, in that argument order. So x outside
+// [0, 1] takes the log of a negative number and gives NaN (pow(1, NaN) = 1 when c = 0); kept
+// on purpose, for SeExpr2's numbers.
 template <class T> struct Contrast {
     static T apply(T x, T c) {
         if (x < T(0.5)) return T(0.5) * bias(1 - c, 2 * x);
@@ -185,6 +188,10 @@ template <class T> struct Remap {
 template <class T> struct Mix { static T apply(T a, T b, T alpha) { return a * (1 - alpha) + b * alpha; } };
 
 } // namespace
+
+double detail::remapValue(double x, double source, double range, double falloff, double interp) {
+    return Remap<double>::apply(x, source, range, falloff, interp);
+}
 
 void addMathBuiltins(FunctionTable& t) {
     // C math
@@ -242,8 +249,10 @@ void addMathBuiltins(FunctionTable& t) {
                            "linearly remaps x in [a1, b1] to [a2, b2] (no clamping)"));
     t.add(mapBuiltin2<Gamma>("gamma", "FP[n] gamma(FP[n] x, FP[n] g)", "gamma correction: x^(1/g)"));
     t.add(mapBuiltin2<Bias>("bias", "FP[n] bias(FP[n] x, FP[n] b)", "x^(log b / log 0.5): b < 0.5 pulls down, b > 0.5 up"));
-    t.add(mapBuiltin2<Contrast>("contrast", "FP[n] contrast(FP[n] x, FP[n] c)",
-                                "contrast around 0.5: c < 0.5 decreases it, c > 0.5 increases it"));
+    t.add(mapBuiltin2<Contrast>(
+        "contrast", "FP[n] contrast(FP[n] x, FP[n] c)",
+        "contrast around 0.5: c < 0.5 decreases it, c > 0.5 increases it; x outside [0, 1] "
+        "gives NaN (0.5 if c = 0), as in SeExpr2"));
     t.add(mapBuiltin2<Boxstep>("boxstep", "FP[n] boxstep(FP[n] x, FP[n] a)", "0 if x < a, else 1"));
     t.add(mapBuiltin3<Linearstep>("linearstep", "FP[n] linearstep(FP[n] x, FP[n] a, FP[n] b)",
                                   "0 below a, 1 above b, linear between (a > b reverses)"));
@@ -257,6 +266,7 @@ void addMathBuiltins(FunctionTable& t) {
 
     detail::addVectorBuiltins(t);
     detail::addSelectionBuiltins(t);
+    detail::addColorBuiltins(t);
 }
 
 } // namespace gale::runtime

@@ -1,5 +1,6 @@
-// Selection built-ins: cycle, pick, choose, wchoose — SeExpr2's integer conversions, weight
-// tables and binary searches, so the same index picks the same value. Also SeExpr2's hash.
+// Selection built-ins: cycle, pick, choose (also as swatch), wchoose — SeExpr2's integer
+// conversions, weight tables and binary searches, so the same index picks the same value. Also
+// SeExpr2's hash.
 #include "runtime/builtins.h"
 #include "runtime/builtins_detail.h"
 
@@ -238,6 +239,10 @@ void addSelectionBuiltins(FunctionTable& t) {
                                "an integer in [lo, hi] picked by hash(index), distributed by the weights (default 1)"));
     t.add(kernelBuiltin<ChooseK>("choose", "FP[n] choose(FP[n] index, FP[n] c1, FP[n] c2, FP[n] choices...)",
                                  "one of the choices by index in [0, 1]"));
+    // SeExpr2 defines swatch as choose: per component, so FP[3] choices give a colour.
+    t.add(kernelBuiltin<ChooseK>(
+        "swatch", "FP[n] swatch(FP[n] index, FP[n] choice0, FP[n] choice1, FP[n] choices...)",
+        "one of the colours (or values) by index in [0, 1]: choose() under its colour name"));
     Builtin wchoose = kernelBuiltin<WchooseK>(
         "wchoose", "FP[n] wchoose(FP[n] index, FP[n] c1, FP[n] w1, FP[n] c2, FP[n] weightedChoices...)",
         "one of the choices by index in [0, 1], each taking a share of [0, 1] proportional to its weight");

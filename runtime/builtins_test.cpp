@@ -71,7 +71,8 @@ TEST_CASE("standard table: the language's non-noise built-ins are all there", "[
         "tand", "acosd", "asind", "atand", "atan2d", "clamp", "round", "min", "max", "hypot", "sign", "invert",
         "compress", "expand", "fit", "gamma", "bias", "contrast", "boxstep", "linearstep", "smoothstep", "gaussstep",
         "remap", "mix", "length", "dot", "cross", "norm", "angle", "ortho", "rotate", "up", "dist", "cycle", "pick",
-        "choose", "wchoose", "spline", "curve", "ccurve", "sprintf", "printf", "getVar"};
+        "choose", "wchoose", "spline", "curve", "ccurve", "sprintf", "printf", "getVar", "rgbtohsl", "hsltorgb", "hsi",
+        "midhsi", "saturate", "swatch"};
     const auto& table = FunctionTable::standard();
     for (const char* name : expected) {
         INFO(name);

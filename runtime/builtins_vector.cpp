@@ -269,8 +269,11 @@ void addVectorBuiltins(FunctionTable& t) {
     t.add(kernelBuiltin<NormK>("norm", "FP[3] norm(FP[3] v)", "v scaled to unit length (the zero vector stays zero)"));
     t.add(kernelBuiltin<AngleK>("angle", "FP[1] angle(FP[3] a, FP[3] b)", "angle between a and b, in radians"));
     t.add(kernelBuiltin<OrthoK>("ortho", "FP[3] ortho(FP[3] a, FP[3] b)", "unit vector orthogonal to a and b: norm(cross(a, b))"));
-    t.add(kernelBuiltin<RotateK>("rotate", "FP[3] rotate(FP[3] v, FP[3] axis, FP[1] angle)",
-                                 "v rotated about axis by angle (radians, right-handed)"));
+    Builtin rotate =
+        kernelBuiltin<RotateK>("rotate", "FP[3] rotate(FP[3] v, FP[3] axis, FP[1] angle)",
+                               "v rotated about axis by angle (radians, right-handed)");
+    rotate.info.firstComponent = true; // SeExpr2 reads angle[0] of a vector angle
+    t.add(rotate);
     t.add(kernelBuiltin<UpK>("up", "FP[3] up(FP[3] v, FP[3] upvec)", "v rotated so that the y axis points along upvec"));
     Builtin dist = kernelBuiltin<DistK>("dist", "FP[1] dist(ANY a, ANY b, ANY coords...)",
                                         "distance between points a and b; also dist(ax, ay, az, bx, by, bz)");
