@@ -1,7 +1,8 @@
 // gale_bench_solver: speed against error for the implicit cloth solver, next to an explicit
 // symplectic-Euler baseline measured in the same run; cost per vertex per step and CG
-// iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix.
-//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size N]
+// iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix; 2 threads against 1.
+//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability|threads] [--size
+//   N]
 //   [--solver NAME]  (DIR gets CSV tables and SVG plots; --only runs one section; --size N and
 //   --solver NAME keep only those rows of the scaling table, e.g. to profile one of them)
 #include "solver/bsr_kernels.h"
@@ -71,9 +72,11 @@ struct FlagSpec {
     AeroJacobian jacobian = AeroJacobian::Projected;
 };
 
-std::unique_ptr<World> makeFlag(const FlagSpec& f, double fps, int substeps, bool explicitEuler, double tol,
-                                int maxHalvings = 0, LinearSolverKind solver = LinearSolverKind::Pcg) {
+std::unique_ptr<World> makeFlag(const FlagSpec& f, double fps, int substeps, bool explicitEuler,
+                                double tol, int maxHalvings = 0,
+                                LinearSolverKind solver = LinearSolverKind::Pcg, int threads = 1) {
     WorldSettings ws;
+    ws.threads = threads;
     ws.fps = fps;
     ws.substeps = substeps;
     ws.maxHalvings = maxHalvings;
@@ -409,6 +412,45 @@ void scalingBench(bool quick, int onlySize, const std::string& onlySolver) {
     }
 }
 
+// ---- 5. two threads against one (issue 14) ---------------------------------------------------
+
+// The same flag (24 fps, 4 substeps, multigrid PCG at tolerance 1e-3) on 1 and 2 threads in the
+// same run: wall time per substep, the ratio, CG iterations, and whether the two runs ended on
+// the same bits (they must: results do not depend on the thread count).
+void threadsBench(bool quick, int onlySize) {
+    std::printf("\n## Two threads against one (issue 14): flag 1 m, sigma 0.1 kg/m^2, stretch 2000 "
+                "N/m, gusty 12 m/s, "
+                "24 fps x 4 substeps, multigrid PCG, CG tol 1e-3; wall time, best of %d runs\n\n",
+                quick ? 1 : 3);
+    std::printf("| cloth | frames | ms/step, 1 thread | ms/step, 2 threads | speed-up | CG "
+                "its/step | same bits |\n"
+                "|---|---|---|---|---|---|---|\n");
+    for (int n : {32, 64, 128}) {
+        if (onlySize > 0 && n != onlySize) continue;
+        if (quick && n == 128) continue;
+        const int frames = n == 128 ? 8 : 24;
+        double best[2] = {1e300, 1e300};
+        double its = 0.0;
+        VecX x[2];
+        for (int rep = 0; rep < (quick ? 1 : 3); ++rep)
+            for (int k = 0; k < 2; ++k) {
+                FlagSpec f;
+                f.n = n;
+                f.wind = 12.0;
+                auto w = makeFlag(f, 24.0, 4, false, 1e-3, 0, LinearSolverKind::Pcg, k + 1);
+                w->bodies()[0]->options().preconditioner = Preconditioner::Multigrid;
+                const RunResult r = runFrames(*w, frames);
+                best[k] = std::min(best[k], r.seconds / std::max<long>(r.substeps, 1));
+                its = double(r.iterations) / std::max<long>(r.substeps, 1);
+                x[k] = r.x;
+            }
+        const bool same = x[0].size() == x[1].size() &&
+                          std::memcmp(x[0].data(), x[1].data(), sizeof(double) * x[0].size()) == 0;
+        std::printf("| %dx%d | %d | %.2f | %.2f | %.2fx | %.1f | %s |\n", n, n, frames,
+                    best[0] * 1e3, best[1] * 1e3, best[0] / best[1], its, same ? "yes" : "NO");
+    }
+}
+
 // ---- 4. edge-on stability (aero.md) -----------------------------------------------------------
 
 void stabilityBench(bool quick) {
@@ -463,9 +505,9 @@ int main(int argc, char** argv) {
     std::string out, only;
     int onlySize = 0;
     std::string onlySolver;
-    const char* usage =
-        "usage: gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size 32|64|128]\n"
-        "       [--solver Jacobi|multigrid|direct]\n";
+    const char* usage = "usage: gale_bench_solver [--quick] [--out DIR] [--only "
+                        "plate|flag|scaling|stability|threads] [--size 32|64|128]\n"
+                        "       [--solver Jacobi|multigrid|direct]\n";
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
@@ -482,5 +524,6 @@ int main(int argc, char** argv) {
     if (only.empty() || only == "flag") flagBench(quick, out);
     if (only.empty() || only == "scaling") scalingBench(quick, onlySize, onlySolver);
     if (only.empty() || only == "stability") stabilityBench(quick);
+    if (only.empty() || only == "threads") threadsBench(quick, onlySize);
     return 0;
 }
