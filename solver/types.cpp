@@ -24,6 +24,10 @@ void parallelChunks(std::size_t n, std::size_t grain,
                       [&](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); });
 }
 
+int arenaConcurrency() {
+    return tbb::this_task_arena::max_concurrency();
+}
+
 Mat3 invertBlockOrScale(const Mat3& d) {
     Mat3 inv;
     bool ok = false;

@@ -29,6 +29,9 @@ inline Eigen::Map<const Vec3> vec3At(const double* p, std::size_t i) {
 void parallelChunks(std::size_t n, std::size_t grain,
                     const std::function<void(std::size_t, std::size_t)>& fn);
 
+// The number of threads of the calling thread's TBB arena (1: parallelChunks runs inline).
+int arenaConcurrency();
+
 // The inverse of a 3×3 block, or I / max|d_ii| when it is singular or its inverse not finite
 // (the fallback of the block-Jacobi and multigrid smoother diagonals).
 Mat3 invertBlockOrScale(const Mat3& d);
