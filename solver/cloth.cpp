@@ -7,11 +7,51 @@
 #include "solver/cloth.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace gale::solver {
 
 namespace {
+// Meshes with fewer triangles assemble on the calling thread alone (the same bits).
+constexpr size_t kParallelTriangles = 2048;
+
+// Greedy colouring of the triangles, visited in index order: each takes the smallest colour
+// no earlier triangle sharing a vertex holds, so the triangles of one colour write disjoint
+// vertices and matrix slots. Returns the triangles sorted by colour (index order within) and
+// the colour boundaries in that list.
+void colourTriangles(const std::vector<std::array<int, 3>>& tris, size_t vertices,
+                     std::vector<int>& order, std::vector<int>& colourStart) {
+    const size_t nt = tris.size();
+    std::vector<int> at(vertices + 1, 0), inc(3 * nt); // vertex → its triangles
+    for (const auto& t : tris)
+        for (int v : t) ++at[v + 1];
+    for (size_t v = 0; v < vertices; ++v) at[v + 1] += at[v];
+    {
+        std::vector<int> fill(at.begin(), at.end() - 1);
+        for (size_t e = 0; e < nt; ++e)
+            for (int v : tris[e]) inc[fill[v]++] = static_cast<int>(e);
+    }
+    std::vector<int> colour(nt, -1), seen; // seen[c] == e: a neighbour of e holds colour c
+    for (size_t e = 0; e < nt; ++e) {
+        for (int v : tris[e])
+            for (int k = at[v]; k < at[v + 1]; ++k) {
+                const int c = colour[inc[k]];
+                if (c >= 0) seen[c] = static_cast<int>(e);
+            }
+        int c = 0;
+        while (c < static_cast<int>(seen.size()) && seen[c] == static_cast<int>(e)) ++c;
+        if (c == static_cast<int>(seen.size())) seen.push_back(-1);
+        colour[e] = c;
+    }
+    colourStart.assign(seen.size() + 1, 0);
+    for (size_t e = 0; e < nt; ++e) ++colourStart[colour[e] + 1];
+    for (size_t c = 0; c + 1 < colourStart.size(); ++c) colourStart[c + 1] += colourStart[c];
+    std::vector<int> fill(colourStart.begin(), colourStart.end() - 1);
+    order.resize(nt);
+    for (size_t e = 0; e < nt; ++e) order[fill[colour[e]]++] = static_cast<int>(e);
+}
+
 VecX flatten(const std::vector<double>& p) { return Eigen::Map<const VecX>(p.data(), p.size()); }
 
 // Adds a triangle's nine blocks (a, b) = cK·K_ab + D9 to A: K from the membrane factors m (null:
@@ -137,52 +177,76 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // Per triangle: membrane (stretch + shear) with Rayleigh damping f = −βKv, and the
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
-    MembraneFactors m;
+    // Triangles colour by colour (mTriOrder), a colour's triangles in parallel: they share no
+    // vertex, so each vertex and slot receives its terms in colour order on any number of
+    // threads; energies summed per triangle in triangle order.
+    if (mTriColourStart.empty() && nt > 0)
+        colourTriangles(mMesh.triangles, vertexCount(), mTriOrder, mTriColourStart);
+    mTriEnergy.resize(nt);
     const Mat3 zero = Mat3::Zero();
-    double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
-    int clamped = 0;
-    for (size_t e = 0; e < nt; ++e) {
-        const auto& tri = mMesh.triangles[e];
-        const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
-        const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
-        Vec3 f3 = Vec3::Zero(); // F/3 per corner
-        Mat3 hD9;               // (h/9)·D
-        bool withD = false;
-        if (aero) {
-            const Vec3 areaNormal = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]);
-            const Vec3 wind =
-                (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) / 3.0;
-            const Vec3 u = (vel[0] + vel[1] + vel[2]) / 3.0;
-            const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
-            const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
-            const AeroResult r =
-                aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd, mMat.aeroModel, in.aeroJacobian);
-            clamped += r.clamped ? 1 : 0;
-            f3 = r.force / 3.0;
-            if (aeroMatrix) {
-                hD9 = (h / 9.0) * r.damping;
-                withD = true;
+    std::atomic<int> clampedAll{0};
+    auto triangles = [&](size_t s0, size_t s1) {
+        MembraneFactors m;
+        int clamped = 0;
+        for (size_t s = s0; s < s1; ++s) {
+            const size_t e = static_cast<size_t>(mTriOrder[s]);
+            const auto& tri = mMesh.triangles[e];
+            const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
+            const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
+            Vec3 f3 = Vec3::Zero(); // F/3 per corner
+            Mat3 hD9;               // (h/9)·D
+            bool withD = false;
+            if (aero) {
+                const Vec3 areaNormal = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]);
+                const Vec3 wind =
+                    (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) /
+                    3.0;
+                const Vec3 u = (vel[0] + vel[1] + vel[2]) / 3.0;
+                const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
+                const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
+                const AeroResult r = aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd,
+                                                  mMat.aeroModel, in.aeroJacobian);
+                clamped += r.clamped ? 1 : 0;
+                f3 = r.force / 3.0;
+                if (aeroMatrix) {
+                    hD9 = (h / 9.0) * r.damping;
+                    withD = true;
+                }
             }
-        }
-        const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
-        if (membrane) {
-            energy += m.energy;
-            // (K v)_a = a_a S_u ẇ_u + b_a S_v ẇ_v + c (Σ_j s_j·v_j) s_a (elastic.h).
-            const Vec3 Swu = m.Su * (m.a[0] * vel[0] + m.a[1] * vel[1] + m.a[2] * vel[2]);
-            const Vec3 Swv = m.Sv * (m.b[0] * vel[0] + m.b[1] * vel[1] + m.b[2] * vel[2]);
-            const double sv = m.shear * (m.s[0].dot(vel[0]) + m.s[1].dot(vel[1]) + m.s[2].dot(vel[2]));
-            for (int a = 0; a < 3; ++a) {
-                const Vec3 kva = m.a[a] * Swu + m.b[a] * Swv + sv * m.s[a];
-                f.segment<3>(3 * tri[a]) += m.f[a] - beta * kva + f3;
-                if (kv) kv->segment<3>(3 * tri[a]) += kva;
+            const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
+            mTriEnergy[e] = membrane ? m.energy : 0.0;
+            if (membrane) {
+                // (K v)_a = a_a S_u ẇ_u + b_a S_v ẇ_v + c (Σ_j s_j·v_j) s_a (elastic.h).
+                const Vec3 Swu = m.Su * (m.a[0] * vel[0] + m.a[1] * vel[1] + m.a[2] * vel[2]);
+                const Vec3 Swv = m.Sv * (m.b[0] * vel[0] + m.b[1] * vel[1] + m.b[2] * vel[2]);
+                const double sv =
+                    m.shear * (m.s[0].dot(vel[0]) + m.s[1].dot(vel[1]) + m.s[2].dot(vel[2]));
+                for (int a = 0; a < 3; ++a) {
+                    const Vec3 kva = m.a[a] * Swu + m.b[a] * Swv + sv * m.s[a];
+                    f.segment<3>(3 * tri[a]) += m.f[a] - beta * kva + f3;
+                    if (kv) kv->segment<3>(3 * tri[a]) += kva;
+                }
+            } else if (aero) {
+                for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
             }
-        } else if (aero) {
-            for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
+            if (A && (membrane || withD))
+                addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK,
+                                  withD ? hD9 : zero);
         }
-        if (A && (membrane || withD))
-            addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK, withD ? hD9 : zero);
+        if (clamped) clampedAll.fetch_add(clamped, std::memory_order_relaxed);
+    };
+    if (nt < kParallelTriangles || arenaConcurrency() < 2) {
+        triangles(0, nt); // the colours one after another: the same bits as below
+    } else {
+        for (size_t c = 0; c + 1 < mTriColourStart.size(); ++c) {
+            const size_t b = mTriColourStart[c];
+            parallelChunks(mTriColourStart[c + 1] - b, 256,
+                           [&](size_t s0, size_t s1) { triangles(b + s0, b + s1); });
+        }
     }
-    out.clamped += clamped;
+    out.clamped += clampedAll.load();
+    double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
+    for (size_t e = 0; e < nt; ++e) energy += mTriEnergy[e];
 
     // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale.
     if (kb != 0.0) {
@@ -206,8 +270,10 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
         }
         // Σ over hinges of cK·Q, summed per slot at setup (mBendCoef).
         if (A)
-            for (size_t k = 0; k < mBendSlots.size(); ++k)
-                A->addDiagonal(mBendSlots[k], cK * kb * mBendCoef[k]);
+            parallelChunks(mBendSlots.size(), 4096, [&](size_t k0, size_t k1) {
+                for (size_t k = k0; k < k1; ++k)
+                    A->addDiagonal(mBendSlots[k], cK * kb * mBendCoef[k]);
+            });
     }
     out.elasticEnergy += energy;
 }
