@@ -30,9 +30,15 @@ constexpr std::size_t kSweepGrain = 128;
 // listed), rows visited in index order: row i takes the smallest colour none of its earlier
 // neighbours holds, so no two rows of a colour are neighbours. Deterministic (it reads the
 // pattern only). Returns `order`: the rows sorted by colour, by index within a colour, and the
-// colour boundaries in it.
-void colourRows(int n, const int* start, const int* cols, std::vector<int>& order,
+// colour boundaries in it. Without `multicolour`: the natural order as one colour.
+void colourRows(bool multicolour, int n, const int* start, const int* cols, std::vector<int>& order,
                 std::vector<int>& colourStart) {
+    if (!multicolour) {
+        order.resize(n);
+        for (int i = 0; i < n; ++i) order[i] = i;
+        colourStart = {0, n};
+        return;
+    }
     std::vector<int> colour(n, -1), seen; // seen[c] == i: a neighbour of i holds colour c
     for (int i = 0; i < n; ++i) {
         for (int k = start[i]; k < start[i + 1]; ++k) {
@@ -103,6 +109,11 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: set-up
 
+BlockMultigrid::Settings& BlockMultigrid::defaults() {
+    static Settings settings;
+    return settings;
+}
+
 // Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
 // slot k holds A's slot mSrcSlot[k]).
 void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
@@ -112,7 +123,7 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     const int n = A.size();
     const std::vector<int>& start = A.blockRowStart();
     const std::vector<int>& cols = A.blockCols();
-    colourRows(n, start.data(), cols.data(), mOrder, L.colourStart);
+    colourRows(mSettings.multicolour, n, start.data(), cols.data(), mOrder, L.colourStart);
     L.visit.resize(n);
     for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
     a.n = n;
@@ -192,7 +203,8 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
         natStart[I + 1] = static_cast<int>(natCols.size());
     }
     std::vector<int> order;
-    colourRows(count, natStart.data(), natCols.data(), order, coarse.colourStart);
+    colourRows(mSettings.multicolour, count, natStart.data(), natCols.data(), order,
+               coarse.colourStart);
     coarse.visit.resize(count);
     for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
     fine.agg.resize(n);

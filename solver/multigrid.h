@@ -71,7 +71,13 @@ public:
         double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
         int coarsest = 48;          // stop coarsening at this many block rows
         int parallelRows = 1024;    // levels with fewer rows sweep sequentially (the same bits)
+        bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
+                                    // always sequential (the benchmark's baseline)
     };
+
+    // The settings new instances start with (process-wide, like setWideKernels: change them
+    // only while no solver is being built; the benchmark compares orderings with it).
+    static Settings& defaults();
 
     Settings& settings() { return mSettings; }
 
@@ -121,7 +127,7 @@ private:
     void smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
 
-    Settings mSettings;
+    Settings mSettings = defaults();
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
     std::vector<double> mPartial; // chunk sums of the fused dot products
