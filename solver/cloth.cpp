@@ -16,40 +16,27 @@ namespace {
 // Meshes with fewer triangles assemble on the calling thread alone (the same bits).
 constexpr size_t kParallelTriangles = 2048;
 
-// Greedy colouring of the triangles, visited in index order: each takes the smallest colour
-// no earlier triangle sharing a vertex holds, so the triangles of one colour write disjoint
-// vertices and matrix slots. Returns the triangles sorted by colour (index order within) and
-// the colour boundaries in that list.
-void colourTriangles(const std::vector<std::array<int, 3>>& tris, size_t vertices,
-                     std::vector<int>& order, std::vector<int>& colourStart) {
-    const size_t nt = tris.size();
-    std::vector<int> at(vertices + 1, 0), inc(3 * nt); // vertex → its triangles
-    for (const auto& t : tris)
-        for (int v : t) ++at[v + 1];
-    for (size_t v = 0; v < vertices; ++v) at[v + 1] += at[v];
-    {
-        std::vector<int> fill(at.begin(), at.end() - 1);
-        for (size_t e = 0; e < nt; ++e)
-            for (int v : tris[e]) inc[fill[v]++] = static_cast<int>(e);
-    }
-    std::vector<int> colour(nt, -1), seen; // seen[c] == e: a neighbour of e holds colour c
-    for (size_t e = 0; e < nt; ++e) {
+// Triangles per block of the parallel assembly order.
+constexpr int kTriangleBlock = 128;
+
+// The parallel assembly order (types.h, ColouredBlocks): consecutive blocks of triangles,
+// two blocks neighbours when they share a vertex, so that the blocks of one colour write
+// disjoint vertices and matrix slots.
+ColouredBlocks colourTriangles(const std::vector<std::array<int, 3>>& tris, size_t vertices) {
+    const int nt = static_cast<int>(tris.size());
+    std::vector<std::vector<int>> blocksAt(vertices); // vertex → the blocks touching it
+    for (int e = 0; e < nt; ++e)
         for (int v : tris[e])
-            for (int k = at[v]; k < at[v + 1]; ++k) {
-                const int c = colour[inc[k]];
-                if (c >= 0) seen[c] = static_cast<int>(e);
-            }
-        int c = 0;
-        while (c < static_cast<int>(seen.size()) && seen[c] == static_cast<int>(e)) ++c;
-        if (c == static_cast<int>(seen.size())) seen.push_back(-1);
-        colour[e] = c;
+            if (blocksAt[v].empty() || blocksAt[v].back() != e / kTriangleBlock)
+                blocksAt[v].push_back(e / kTriangleBlock);
+    std::vector<std::vector<int>> near((nt + kTriangleBlock - 1) / kTriangleBlock);
+    for (const std::vector<int>& bs : blocksAt)
+        for (int b : bs) near[b].insert(near[b].end(), bs.begin(), bs.end());
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
     }
-    colourStart.assign(seen.size() + 1, 0);
-    for (size_t e = 0; e < nt; ++e) ++colourStart[colour[e] + 1];
-    for (size_t c = 0; c + 1 < colourStart.size(); ++c) colourStart[c + 1] += colourStart[c];
-    std::vector<int> fill(colourStart.begin(), colourStart.end() - 1);
-    order.resize(nt);
-    for (size_t e = 0; e < nt; ++e) order[fill[colour[e]]++] = static_cast<int>(e);
+    return colourBlocks(nt, kTriangleBlock, near);
 }
 
 VecX flatten(const std::vector<double>& p) { return Eigen::Map<const VecX>(p.data(), p.size()); }
@@ -177,11 +164,10 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // Per triangle: membrane (stretch + shear) with Rayleigh damping f = −βKv, and the
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
-    // Triangles colour by colour (mTriOrder), a colour's triangles in parallel: they share no
-    // vertex, so each vertex and slot receives its terms in colour order on any number of
-    // threads; energies summed per triangle in triangle order.
-    if (mTriColourStart.empty() && nt > 0)
-        colourTriangles(mMesh.triangles, vertexCount(), mTriOrder, mTriColourStart);
+    // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
+    // they share no vertex, so each vertex and slot receives its terms in the same order on any
+    // number of threads; energies summed per triangle in triangle order.
+    if (mTriBlocks.order.size() != nt) mTriBlocks = colourTriangles(mMesh.triangles, vertexCount());
     mTriEnergy.resize(nt);
     const Mat3 zero = Mat3::Zero();
     std::atomic<int> clampedAll{0};
@@ -189,7 +175,7 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
         MembraneFactors m;
         int clamped = 0;
         for (size_t s = s0; s < s1; ++s) {
-            const size_t e = static_cast<size_t>(mTriOrder[s]);
+            const size_t e = static_cast<size_t>(mTriBlocks.order[s]);
             const auto& tri = mMesh.triangles[e];
             const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
             const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
@@ -235,15 +221,8 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
         }
         if (clamped) clampedAll.fetch_add(clamped, std::memory_order_relaxed);
     };
-    if (nt < kParallelTriangles || arenaConcurrency() < 2) {
-        triangles(0, nt); // the colours one after another: the same bits as below
-    } else {
-        for (size_t c = 0; c + 1 < mTriColourStart.size(); ++c) {
-            const size_t b = mTriColourStart[c];
-            parallelChunks(mTriColourStart[c + 1] - b, 256,
-                           [&](size_t s0, size_t s1) { triangles(b + s0, b + s1); });
-        }
-    }
+    forEachColour(mTriBlocks, false, nt >= kParallelTriangles && arenaConcurrency() >= 2,
+                  triangles);
     out.clamped += clampedAll.load();
     double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
     for (size_t e = 0; e < nt; ++e) energy += mTriEnergy[e];

@@ -52,9 +52,9 @@ private:
     std::vector<int> mBendSlots;    // matrix slots the hinges touch
     std::vector<double> mBendCoef;  // per slot: Σ over hinges of scale·k_a·k_b (bending Hessian / k_b)
     std::vector<double> mTriLift, mTriDrag; // mean painted map value per triangle (or empty)
-    // Parallel assembly (built on the first addForces): the triangles in colour order, no two
-    // of a colour sharing a vertex; colour c is mTriOrder[mTriColourStart[c] .. [c+1]).
-    std::vector<int> mTriOrder, mTriColourStart;
+    // Parallel assembly (built on the first addForces): blocks of triangles, no two blocks of
+    // a colour sharing a vertex (types.h).
+    ColouredBlocks mTriBlocks;
     std::vector<double> mTriEnergy; // per triangle, summed in triangle order
     int mDegenerate = 0;
 };

@@ -23,39 +23,23 @@ namespace {
 using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
 
-// Rows per chunk of one colour in a parallel sweep.
-constexpr std::size_t kSweepGrain = 128;
-
-// Greedy colouring of the graph with neighbours cols[start[i] .. start[i+1]) (i itself may be
-// listed), rows visited in index order: row i takes the smallest colour none of its earlier
-// neighbours holds, so no two rows of a colour are neighbours. Deterministic (it reads the
-// pattern only). Returns `order`: the rows sorted by colour, by index within a colour, and the
-// colour boundaries in it. Without `multicolour`: the natural order as one colour.
-void colourRows(bool multicolour, int n, const int* start, const int* cols, std::vector<int>& order,
-                std::vector<int>& colourStart) {
-    if (!multicolour) {
-        order.resize(n);
-        for (int i = 0; i < n; ++i) order[i] = i;
-        colourStart = {0, n};
-        return;
-    }
-    std::vector<int> colour(n, -1), seen; // seen[c] == i: a neighbour of i holds colour c
+// The multicolour ordering of a level (types.h, ColouredBlocks): its rows, in natural order, cut
+// into blocks of `rowBlock`; two blocks neighbour when a row of one shares a matrix block
+// with a row of the other. Without `multicolour`: the natural order, one block.
+ColouredBlocks colourRows(bool multicolour, int rowBlock, int n, const int* start,
+                          const int* cols) {
+    if (!multicolour || rowBlock <= 0 || n <= rowBlock) return naturalBlocks(n);
+    std::vector<std::vector<int>> near((n + rowBlock - 1) / rowBlock);
     for (int i = 0; i < n; ++i) {
-        for (int k = start[i]; k < start[i + 1]; ++k) {
-            const int c = colour[cols[k]];
-            if (c >= 0) seen[c] = i;
-        }
-        int c = 0;
-        while (c < static_cast<int>(seen.size()) && seen[c] == i) ++c;
-        if (c == static_cast<int>(seen.size())) seen.push_back(-1);
-        colour[i] = c;
+        std::vector<int>& nb = near[i / rowBlock];
+        for (int k = start[i]; k < start[i + 1]; ++k)
+            if (cols[k] / rowBlock != i / rowBlock) nb.push_back(cols[k] / rowBlock);
     }
-    colourStart.assign(seen.size() + 1, 0);
-    for (int i = 0; i < n; ++i) ++colourStart[colour[i] + 1];
-    for (size_t c = 0; c + 1 < colourStart.size(); ++c) colourStart[c + 1] += colourStart[c];
-    std::vector<int> fill(colourStart.begin(), colourStart.end() - 1);
-    order.resize(n);
-    for (int i = 0; i < n; ++i) order[fill[colour[i]]++] = i;
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    return colourBlocks(n, rowBlock, near);
 }
 
 int slotIn(const BsrMatrix& m, int i, int j) {
@@ -123,7 +107,9 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     const int n = A.size();
     const std::vector<int>& start = A.blockRowStart();
     const std::vector<int>& cols = A.blockCols();
-    colourRows(mSettings.multicolour, n, start.data(), cols.data(), mOrder, L.colourStart);
+    L.colouring =
+        colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
+    mOrder = L.colouring.order;
     L.visit.resize(n);
     for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
     a.n = n;
@@ -202,9 +188,9 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
         natCols.insert(natCols.end(), rows[I].begin(), rows[I].end());
         natStart[I + 1] = static_cast<int>(natCols.size());
     }
-    std::vector<int> order;
-    colourRows(mSettings.multicolour, count, natStart.data(), natCols.data(), order,
-               coarse.colourStart);
+    coarse.colouring = colourRows(mSettings.multicolour, mSettings.rowBlock, count, natStart.data(),
+                                  natCols.data());
+    const std::vector<int>& order = coarse.colouring.order;
     coarse.visit.resize(count);
     for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
     fine.agg.resize(n);
@@ -426,26 +412,20 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
         g.t = residual ? L.t.data() : nullptr;
         g.forward = forward;
         g.fromZero = fromZero && forward;
-        const int colours = static_cast<int>(L.colourStart.size()) - 1;
-        if (n < mSettings.parallelRows || colours < 2 || arenaConcurrency() < 2) {
-            gaussSeidelSweep(g); // the colours one after another: the same bits as below
-            return;
-        }
-        // Colour by colour (reversed for the backward sweep), each colour's rows in parallel
-        // chunks. A chunk may not push t to earlier rows another chunk also reaches: t is
-        // pulled afterwards, the same sums in the same order.
-        g.t = nullptr;
-        for (int s = 0; s < colours; ++s) {
-            const int c = forward ? s : colours - 1 - s;
-            const int b = L.colourStart[c];
-            parallelChunks(static_cast<size_t>(L.colourStart[c + 1] - b), kSweepGrain,
-                           [&](size_t i0, size_t i1) {
-                               GaussSeidelSweep part = g;
-                               part.begin = b + static_cast<int>(i0);
-                               part.end = b + static_cast<int>(i1);
-                               gaussSeidelSweep(part);
-                           });
-        }
+        const bool parallel =
+            n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
+        // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
+        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
+        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
+        // the same sums in the same order.
+        if (parallel) g.t = nullptr;
+        forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
+            GaussSeidelSweep part = g;
+            part.begin = static_cast<int>(i0);
+            part.end = static_cast<int>(i1);
+            gaussSeidelSweep(part);
+        });
+        if (!parallel) return;
         if (residual && g.fromZero) {
             const BsrPattern p = a.pattern();
             parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {

@@ -50,15 +50,19 @@ struct BsrMatrix {
 // level, so the preconditioner is symmetric positive definite.
 //
 // Multicolour ordering (Adams 2001, "A distributed memory unstructured Gauss–Seidel algorithm
-// for multigrid smoothers"; Saad, "Iterative Methods for Sparse Linear Systems" §12.4): each
-// level's block rows are coloured greedily, in their natural order, so that no two rows of a
-// colour share a block, and the level is stored renumbered colour by colour (natural order
-// within a colour). Gauss–Seidel in that row order is then multicolour Gauss–Seidel: the rows
-// of one colour read only the other colours' x, so they are swept in parallel chunks and the
-// result is the same bits on any number of threads (and the same as the one sequential sweep
-// small levels take). The backward sweep visits the colours in reverse: it stays the exact
-// adjoint of the forward one. Aggregation visits the rows in their natural order, so the
-// renumbering does not change the aggregates. Vectors passed to apply, multiply and
+// for multigrid smoothers"; Saad, "Iterative Methods for Sparse Linear Systems" §12.4, here
+// by blocks of rows): each level's rows, in natural order, are cut into blocks of
+// Settings::rowBlock, the blocks coloured greedily in block order so that no two blocks of a
+// colour are coupled, and the level is stored renumbered colour by colour (blocks and rows in
+// natural order within a colour). Gauss–Seidel in that row order is lexicographic inside a
+// block and multicolour between blocks: the blocks of one colour read only the other colours'
+// x, so they are swept in parallel and the result is the same bits on any number of threads
+// (and the same as the one sequential sweep small levels take). The backward sweep visits the
+// colours in reverse, each block backwards: it stays the exact adjoint of the forward one.
+// Whole blocks keep the natural order's memory locality and most of its coupling, so the
+// smoother is nearly as strong as the lexicographic one (bench/README.md). Aggregation visits
+// the rows in their natural order, so the renumbering does not change the aggregates. Vectors
+// passed to apply, multiply and
 // multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder). The smoother reads a
 // single-precision copy of each level's matrix (half the memory traffic; the V-cycle only
 // approximates Â⁻¹ anyway), while conjugate gradient multiplies with Â in double precision.
@@ -71,6 +75,7 @@ public:
         double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
         int coarsest = 48;          // stop coarsening at this many block rows
         int parallelRows = 1024;    // levels with fewer rows sweep sequentially (the same bits)
+        int rowBlock = 64;          // rows per block of the multicolour ordering
         bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
                                     // always sequential (the benchmark's baseline)
     };
@@ -88,9 +93,10 @@ public:
     // 3n vectors from A's vertex order to level 0's colour order and back.
     void toLevelOrder(const double* natural, double* level) const;
     void fromLevelOrder(const double* level, double* natural) const;
-    // A level's matrix (in its colour order) and its colours: rows colourStart[c] .. [c+1].
+    // A level's matrix (in its colour order) and its multicolour ordering (its order lists the
+    // natural index of each row).
     const BsrMatrix& matrix(int level) const { return mLevels[level].a; }
-    const std::vector<int>& colourStart(int level) const { return mLevels[level].colourStart; }
+    const ColouredBlocks& colouring(int level) const { return mLevels[level].colouring; }
     // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero); returns rᵀz
     // summed as deterministicDot does (fused with the copy-out).
     double apply(const double* r, double* z);
@@ -115,7 +121,7 @@ private:
         std::vector<int> coarseSlot;   // slot of the next level's matrix per slot
         std::vector<int> gatherStart,
             gather;                    // per slot of the next level: the slots summed into it
-        std::vector<int> colourStart;  // rows of colour c: colourStart[c] .. colourStart[c+1]
+        ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
         std::vector<int> visit;        // row of each natural index (the aggregation's order)
         std::vector<double> r, x, t;   // 3n work vectors
     };

@@ -260,20 +260,30 @@ TEST_CASE("multigrid: each level's colours are independent sets", "[multigrid]")
     CHECK(std::count(seen.begin(), seen.end(), 1) == s.A.size());
     for (int l = 0; l < mg.levelCount(); ++l) {
         const BsrMatrix& a = mg.matrix(l);
-        const std::vector<int>& cs = mg.colourStart(l);
-        INFO("level " << l << ": " << a.n << " rows, " << cs.size() - 1 << " colours");
-        REQUIRE(cs.front() == 0);
-        REQUIRE(cs.back() == a.n);
-        std::vector<int> colour(a.n);
-        for (size_t c = 0; c + 1 < cs.size(); ++c)
-            for (int p = cs[c]; p < cs[c + 1]; ++p) colour[p] = static_cast<int>(c);
-        int sameColour = 0;
+        const ColouredBlocks& cb = mg.colouring(l);
+        INFO("level " << l << ": " << a.n << " rows, " << cb.blockStart.size() - 1 << " blocks, "
+                      << cb.colours() << " colours");
+        REQUIRE(cb.blockStart.back() == a.n);
+        REQUIRE(cb.colourStart.back() == static_cast<int>(cb.blockStart.size()) - 1);
+        std::vector<int> colour(a.n), block(a.n);
+        for (int c = 0; c < cb.colours(); ++c)
+            for (int bl = cb.colourStart[c]; bl < cb.colourStart[c + 1]; ++bl)
+                for (int p = cb.blockStart[bl]; p < cb.blockStart[bl + 1]; ++p)
+                    colour[p] = c, block[p] = bl;
+        int coupled = 0; // blocks of a row's colour other than its own that it is coupled to
         for (int p = 0; p < a.n; ++p)
-            for (int k = a.start[p]; k < a.start[p + 1]; ++k)
-                if (a.cols[k] != p && colour[a.cols[k]] == colour[p]) ++sameColour;
-        CHECK(sameColour == 0);
-        // A sheet of degree-6 vertices: greedy colouring in row order needs only a few colours.
-        if (l == 0) CHECK(cs.size() - 1 <= 7);
+            for (int k = a.start[p]; k < a.start[p + 1]; ++k) {
+                const int q = a.cols[k];
+                if (block[q] != block[p] && colour[q] == colour[p]) ++coupled;
+            }
+        CHECK(coupled == 0);
+        // Level 0 of a 48×48 sheet (blocks of 64 rows, couplings to ±49 rows): a few colours
+        // of many blocks, enough to share between threads.
+        if (l == 0) {
+            CHECK(cb.colours() >= 2);
+            CHECK(cb.colours() <= 4);
+            CHECK(cb.blockStart.size() - 1 >= 30);
+        }
     }
 }
 
