@@ -13,30 +13,33 @@
 namespace gale::solver {
 
 namespace {
-// Meshes with fewer triangles assemble on the calling thread alone (the same bits).
-constexpr size_t kParallelTriangles = 2048;
+// Meshes with fewer elements assemble on the calling thread alone (the same bits).
+constexpr size_t kParallelElements = 2048;
 
-// Triangles per block of the parallel assembly order.
-constexpr int kTriangleBlock = 128;
+// Elements (triangles, hinges) per block of the parallel assembly order.
+constexpr int kElementBlock = 128;
 
-// The parallel assembly order (types.h, ColouredBlocks): consecutive blocks of triangles,
-// two blocks neighbours when they share a vertex, so that the blocks of one colour write
-// disjoint vertices and matrix slots.
-ColouredBlocks colourTriangles(const std::vector<std::array<int, 3>>& tris, size_t vertices) {
-    const int nt = static_cast<int>(tris.size());
+// The parallel assembly order (types.h, ColouredBlocks) of elements with K corners:
+// consecutive blocks of elements, two blocks neighbours when they share a vertex, so that the
+// blocks of one colour write disjoint vertices and matrix slots.
+template <size_t K, class Corners>
+ColouredBlocks colourElements(size_t count, size_t vertices, Corners corners) {
+    const int n = static_cast<int>(count);
     std::vector<std::vector<int>> blocksAt(vertices); // vertex → the blocks touching it
-    for (int e = 0; e < nt; ++e)
-        for (int v : tris[e])
-            if (blocksAt[v].empty() || blocksAt[v].back() != e / kTriangleBlock)
-                blocksAt[v].push_back(e / kTriangleBlock);
-    std::vector<std::vector<int>> near((nt + kTriangleBlock - 1) / kTriangleBlock);
+    for (int e = 0; e < n; ++e) {
+        const std::array<int, K>& c = corners(e);
+        for (int v : c)
+            if (blocksAt[v].empty() || blocksAt[v].back() != e / kElementBlock)
+                blocksAt[v].push_back(e / kElementBlock);
+    }
+    std::vector<std::vector<int>> near((n + kElementBlock - 1) / kElementBlock);
     for (const std::vector<int>& bs : blocksAt)
         for (int b : bs) near[b].insert(near[b].end(), bs.begin(), bs.end());
     for (std::vector<int>& nb : near) {
         std::sort(nb.begin(), nb.end());
         nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
     }
-    return colourBlocks(nt, kTriangleBlock, near);
+    return colourBlocks(n, kElementBlock, near);
 }
 
 VecX flatten(const std::vector<double>& p) { return Eigen::Map<const VecX>(p.data(), p.size()); }
@@ -167,7 +170,10 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
     // they share no vertex, so each vertex and slot receives its terms in the same order on any
     // number of threads; energies summed per triangle in triangle order.
-    if (mTriBlocks.order.size() != nt) mTriBlocks = colourTriangles(mMesh.triangles, vertexCount());
+    if (mTriBlocks.order.size() != nt)
+        mTriBlocks = colourElements<3>(nt, vertexCount(), [&](int e) -> const std::array<int, 3>& {
+            return mMesh.triangles[e];
+        });
     mTriEnergy.resize(nt);
     const Mat3 zero = Mat3::Zero();
     std::atomic<int> clampedAll{0};
@@ -221,32 +227,45 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
         }
         if (clamped) clampedAll.fetch_add(clamped, std::memory_order_relaxed);
     };
-    forEachColour(mTriBlocks, false, nt >= kParallelTriangles && arenaConcurrency() >= 2,
-                  triangles);
+    forEachColour(mTriBlocks, false, nt >= kParallelElements && arenaConcurrency() >= 2, triangles);
     out.clamped += clampedAll.load();
     double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
     for (size_t e = 0; e < nt; ++e) energy += mTriEnergy[e];
 
-    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale.
+    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale; hinges in coloured
+    // blocks like the triangles, energies summed per hinge in hinge order.
     if (kb != 0.0) {
-        for (size_t hi = 0; hi < mHinges.size(); ++hi) {
-            const HingeRest& r = mHingeRest[hi];
-            if (!(r.scale > 0.0)) continue;
-            const auto& v = mHinges[hi].v;
-            const double c = kb * r.scale;
-            Vec3 s = Vec3::Zero(), sv = Vec3::Zero();
-            for (int a = 0; a < 4; ++a) {
-                s += r.k[a] * vec3At(in.x, v[a]);
-                sv += r.k[a] * vec3At(in.v, v[a]);
+        const size_t nh = mHinges.size();
+        if (mHingeBlocks.order.size() != nh)
+            mHingeBlocks =
+                colourElements<4>(nh, vertexCount(),
+                                  [&](int e) -> const std::array<int, 4>& { return mHinges[e].v; });
+        mHingeEnergy.resize(nh);
+        auto hinges = [&](size_t s0, size_t s1) {
+            for (size_t q = s0; q < s1; ++q) {
+                const size_t hi = static_cast<size_t>(mHingeBlocks.order[q]);
+                const HingeRest& r = mHingeRest[hi];
+                mHingeEnergy[hi] = 0.0;
+                if (!(r.scale > 0.0)) continue;
+                const auto& v = mHinges[hi].v;
+                const double c = kb * r.scale;
+                Vec3 s = Vec3::Zero(), sv = Vec3::Zero();
+                for (int a = 0; a < 4; ++a) {
+                    s += r.k[a] * vec3At(in.x, v[a]);
+                    sv += r.k[a] * vec3At(in.v, v[a]);
+                }
+                mHingeEnergy[hi] = 0.5 * c * s.squaredNorm();
+                // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.
+                const Vec3 fs = c * (s + beta * sv), fv = c * sv;
+                for (int a = 0; a < 4; ++a) {
+                    f.segment<3>(3 * v[a]) -= r.k[a] * fs;
+                    if (kv) kv->segment<3>(3 * v[a]) += r.k[a] * fv;
+                }
             }
-            energy += 0.5 * c * s.squaredNorm();
-            // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.
-            const Vec3 fs = c * (s + beta * sv), fv = c * sv;
-            for (int a = 0; a < 4; ++a) {
-                f.segment<3>(3 * v[a]) -= r.k[a] * fs;
-                if (kv) kv->segment<3>(3 * v[a]) += r.k[a] * fv;
-            }
-        }
+        };
+        forEachColour(mHingeBlocks, false, nh >= kParallelElements && arenaConcurrency() >= 2,
+                      hinges);
+        for (size_t hi = 0; hi < nh; ++hi) energy += mHingeEnergy[hi];
         // Σ over hinges of cK·Q, summed per slot at setup (mBendCoef).
         if (A)
             parallelChunks(mBendSlots.size(), 4096, [&](size_t k0, size_t k1) {

@@ -75,7 +75,7 @@ public:
         double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
         int coarsest = 48;          // stop coarsening at this many block rows
         int parallelRows = 1024;    // levels with fewer rows sweep sequentially (the same bits)
-        int rowBlock = 64;          // rows per block of the multicolour ordering
+        int rowBlock = 128;         // rows per block of the multicolour ordering
         bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
                                     // always sequential (the benchmark's baseline)
     };

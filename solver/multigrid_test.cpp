@@ -277,12 +277,12 @@ TEST_CASE("multigrid: each level's colours are independent sets", "[multigrid]")
                 if (block[q] != block[p] && colour[q] == colour[p]) ++coupled;
             }
         CHECK(coupled == 0);
-        // Level 0 of a 48×48 sheet (blocks of 64 rows, couplings to ±49 rows): a few colours
+        // Level 0 of a 48×48 sheet (blocks of 128 rows, couplings to ±49 rows): a few colours
         // of many blocks, enough to share between threads.
         if (l == 0) {
             CHECK(cb.colours() >= 2);
             CHECK(cb.colours() <= 4);
-            CHECK(cb.blockStart.size() - 1 >= 30);
+            CHECK(cb.blockStart.size() - 1 >= 18);
         }
     }
 }
