@@ -1,12 +1,15 @@
 // gale_bench_solver: speed against error for the implicit cloth solver, next to an explicit
 // symplectic-Euler baseline measured in the same run; cost per vertex per step and CG
-// iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix.
-//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size N]
+// iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix; 2 threads against 1.
+//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability|threads] [--size
+//   N]
 //   [--solver NAME]  (DIR gets CSV tables and SVG plots; --only runs one section; --size N and
 //   --solver NAME keep only those rows of the scaling table, e.g. to profile one of them)
 #include "solver/bsr_kernels.h"
 #include "solver/cloth.h"
 #include "solver/linear.h"
+#include "solver/multigrid.h"
+#include "solver/types.h"
 #include "solver/world.h"
 
 #include <chrono>
@@ -33,12 +36,16 @@ class Wind : public gale::fields::Field {
 public:
     using Fn = std::function<Vec3(const Vec3&, double)>;
     explicit Wind(Fn fn) : mFn(std::move(fn)) {}
+    // Points in parallel chunks on the caller's arena, as the library's fields sample
+    // (per point, so the same values on any number of threads).
     gale::fields::SampleStatus sample(const double* p, size_t n, const gale::fields::SampleTime& when,
                                       double* out) const override {
-        for (size_t i = 0; i < n; ++i) {
-            const Vec3 v = mFn(Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), when.time);
-            out[3 * i] = v.x(), out[3 * i + 1] = v.y(), out[3 * i + 2] = v.z();
-        }
+        parallelChunks(n, 1024, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) {
+                const Vec3 v = mFn(Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]), when.time);
+                out[3 * i] = v.x(), out[3 * i + 1] = v.y(), out[3 * i + 2] = v.z();
+            }
+        });
         return {};
     }
     std::string describe() const override { return "bench wind"; }
@@ -71,9 +78,11 @@ struct FlagSpec {
     AeroJacobian jacobian = AeroJacobian::Projected;
 };
 
-std::unique_ptr<World> makeFlag(const FlagSpec& f, double fps, int substeps, bool explicitEuler, double tol,
-                                int maxHalvings = 0, LinearSolverKind solver = LinearSolverKind::Pcg) {
+std::unique_ptr<World> makeFlag(const FlagSpec& f, double fps, int substeps, bool explicitEuler,
+                                double tol, int maxHalvings = 0,
+                                LinearSolverKind solver = LinearSolverKind::Pcg, int threads = 1) {
     WorldSettings ws;
+    ws.threads = threads;
     ws.fps = fps;
     ws.substeps = substeps;
     ws.maxHalvings = maxHalvings;
@@ -409,6 +418,61 @@ void scalingBench(bool quick, int onlySize, const std::string& onlySolver) {
     }
 }
 
+// ---- 5. two threads against one (issue 14) ---------------------------------------------------
+
+// The same flag (24 fps, 4 substeps, multigrid PCG at tolerance 1e-3) in three configurations
+// measured in the same run: the lexicographic (natural-order, sequential) Gauss–Seidel smoother
+// on 1 thread — the smoother before issue 14 — and the multicolour smoother on 1 and 2
+// threads. Wall time per substep (best of the repeats), CG iterations per substep, the ratios,
+// and whether the 1- and 2-thread multicolour runs ended on the same bits (they must).
+void threadsBench(bool quick, int onlySize) {
+    const int repeats = quick ? 1 : 3;
+    std::printf(
+        "\n## Two threads against one (issue 14): flag 1 m, sigma 0.1 kg/m^2, stretch 2000 N/m, "
+        "gusty 12 m/s, "
+        "24 fps x 4 substeps, multigrid PCG, CG tol 1e-3; wall ms per substep, best of %d\n\n",
+        repeats);
+    std::printf("| cloth | frames | lexicographic GS, 1 thread: ms (its) | multicolour, 1 thread: "
+                "ms (its) | "
+                "multicolour, 2 threads: ms | 1-thread cost of multicolour | 2-thread speed-up | "
+                "same bits |\n"
+                "|---|---|---|---|---|---|---|---|\n");
+    const BlockMultigrid::Settings initial = BlockMultigrid::defaults();
+    struct Config {
+        bool multicolour;
+        int threads;
+    };
+    const Config configs[] = {{false, 1}, {true, 1}, {true, 2}};
+    for (int n : {32, 64, 128}) {
+        if (onlySize > 0 && n != onlySize) continue;
+        if (quick && n == 128) continue;
+        const int frames = n == 128 ? 8 : 24;
+        double best[3] = {1e300, 1e300, 1e300}, its[3] = {0, 0, 0};
+        VecX x[3];
+        for (int rep = 0; rep < repeats; ++rep)
+            for (int k = 0; k < 3; ++k) {
+                BlockMultigrid::defaults().multicolour = configs[k].multicolour;
+                FlagSpec f;
+                f.n = n;
+                f.wind = 12.0;
+                auto w =
+                    makeFlag(f, 24.0, 4, false, 1e-3, 0, LinearSolverKind::Pcg, configs[k].threads);
+                w->bodies()[0]->options().preconditioner = Preconditioner::Multigrid;
+                const RunResult r = runFrames(*w, frames);
+                best[k] = std::min(best[k], r.seconds / std::max<long>(r.substeps, 1));
+                its[k] = double(r.iterations) / std::max<long>(r.substeps, 1);
+                x[k] = r.x;
+            }
+        BlockMultigrid::defaults() = initial;
+        const bool same = x[1].size() == x[2].size() &&
+                          std::memcmp(x[1].data(), x[2].data(), sizeof(double) * x[1].size()) == 0;
+        std::printf("| %dx%d | %d | %.2f (%.1f) | %.2f (%.1f) | %.2f | %.2fx | **%.2fx** (%.2fx vs "
+                    "lexicographic) | %s |\n",
+                    n, n, frames, best[0] * 1e3, its[0], best[1] * 1e3, its[1], best[2] * 1e3,
+                    best[1] / best[0], best[1] / best[2], best[0] / best[2], same ? "yes" : "NO");
+    }
+}
+
 // ---- 4. edge-on stability (aero.md) -----------------------------------------------------------
 
 void stabilityBench(bool quick) {
@@ -463,9 +527,9 @@ int main(int argc, char** argv) {
     std::string out, only;
     int onlySize = 0;
     std::string onlySolver;
-    const char* usage =
-        "usage: gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability] [--size 32|64|128]\n"
-        "       [--solver Jacobi|multigrid|direct]\n";
+    const char* usage = "usage: gale_bench_solver [--quick] [--out DIR] [--only "
+                        "plate|flag|scaling|stability|threads] [--size 32|64|128]\n"
+                        "       [--solver Jacobi|multigrid|direct]\n";
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
@@ -482,5 +546,6 @@ int main(int argc, char** argv) {
     if (only.empty() || only == "flag") flagBench(quick, out);
     if (only.empty() || only == "scaling") scalingBench(quick, onlySize, onlySolver);
     if (only.empty() || only == "stability") stabilityBench(quick);
+    if (only.empty() || only == "threads") threadsBench(quick, onlySize);
     return 0;
 }

@@ -15,6 +15,8 @@ void bsrMultiplyRowsAvx2(const BsrPattern& m, const double* val, const double* x
 void bsrMultiplyRowsAvx2(const BsrPattern& m, const float* val, const double* x, double* y, std::size_t i0,
                          std::size_t i1);
 void gaussSeidelSweepAvx2(const GaussSeidelSweep& g);
+void bsrUpperResidualRowsAvx2(const BsrPattern& m, const float* val, const double* x, double* t,
+                              std::size_t i0, std::size_t i1);
 #endif
 
 namespace {
@@ -93,6 +95,14 @@ void gaussSeidelSweep(const GaussSeidelSweep& g) {
     if (wideKernels()) return gaussSeidelSweepAvx2(g);
 #endif
     kernels::sweepAny<ScalarOps>(g);
+}
+
+void bsrUpperResidualRows(const BsrPattern& m, const float* val, const double* x, double* t,
+                          std::size_t i0, std::size_t i1) {
+#if defined(GALE_HAVE_AVX2_KERNELS)
+    if (wideKernels()) return bsrUpperResidualRowsAvx2(m, val, x, t, i0, i1);
+#endif
+    kernels::upperResidualRows<ScalarOps>(m, val, x, t, i0, i1);
 }
 
 } // namespace gale::solver

@@ -25,9 +25,11 @@ void bsrMultiplyRows(const BsrPattern& m, const double* val, const double* x, do
 void bsrMultiplyRows(const BsrPattern& m, const float* val, const double* x, double* y, std::size_t i0,
                      std::size_t i1);
 
-// One block Gauss–Seidel sweep over all rows of A x = r:
+// One block Gauss–Seidel sweep over the rows [begin, end) of A x = r (end < 0: to the last row):
 //   x_i += D_i⁻¹ (r_i − Σ_j A_ij x_j)
 // in row order (forward) or reverse (backward); dinv holds D_i⁻¹ column-major, 9 per row (+pad).
+// Rows that share no block (one colour of a multicolour ordering) may be swept in parallel
+// chunks: each reads only the other colours' x.
 // fromZero (forward only): x is zero on entry, so row i reads only the columns before i.
 // With fromZero, `t` (if not null) receives r − A x after the sweep without a second pass:
 // row i then satisfies its equation, and its blocks below the diagonal, read through `mirror`
@@ -42,8 +44,16 @@ struct GaussSeidelSweep {
     double* t = nullptr;
     bool forward = true;
     bool fromZero = false;
+    int begin = 0, end = -1;
 };
 void gaussSeidelSweep(const GaussSeidelSweep& s);
+
+// t_i = −Σ_{k after diag[i]} A_ik x_k for the block rows i in [i0, i1): after a forward sweep
+// from zero this is r − A x (row i satisfies its own equation but for the later columns) — the
+// same terms, subtracted in the same order, as the `t` a GaussSeidelSweep pushes, so the same
+// bits; a pull over rows, for when the sweep ran in parallel chunks that may not push.
+void bsrUpperResidualRows(const BsrPattern& m, const float* val, const double* x, double* t,
+                          std::size_t i0, std::size_t i1);
 
 // Whether the AVX2 + FMA kernels are in use (built, the CPU has them, and not switched off);
 // tests switch them off to check the portable kernels against the same references. The

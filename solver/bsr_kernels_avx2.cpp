@@ -57,6 +57,10 @@ void bsrMultiplyRowsAvx2(const BsrPattern& m, const float* val, const double* x,
     kernels::multiplyRows<WideOps>(m, val, x, y, i0, i1);
 }
 void gaussSeidelSweepAvx2(const GaussSeidelSweep& g) { kernels::sweepAny<WideOps>(g); }
+void bsrUpperResidualRowsAvx2(const BsrPattern& m, const float* val, const double* x, double* t,
+                              std::size_t i0, std::size_t i1) {
+    kernels::upperResidualRows<WideOps>(m, val, x, t, i0, i1);
+}
 
 } // namespace gale::solver
 #endif

@@ -34,11 +34,12 @@ inline void sweep(const GaussSeidelSweep& g) {
     const double* r = g.r;
     double* x = g.x;
     double* t = g.t; // (locals: the stores below might alias `g` for all the compiler knows)
-    for (int s = 0; s < n; ++s) {
-        const int i = Forward ? s : n - 1 - s;
+    const int begin = g.begin, end = g.end < 0 ? n : g.end;
+    for (int s = 0; s < end - begin; ++s) {
+        const int i = Forward ? begin + s : end - 1 - s;
         typename Ops::V y = Ops::load3(r + 3 * static_cast<std::size_t>(i));
-        const int end = FromZero ? diag[i] : start[i + 1];
-        for (int k = start[i]; k < end; ++k)
+        const int last = FromZero ? diag[i] : start[i + 1];
+        for (int k = start[i]; k < last; ++k)
             y = Ops::sub(y, Ops::block(val + 9 * static_cast<std::size_t>(k), x + 3 * static_cast<std::size_t>(cols[k])));
         double* xi = x + 3 * static_cast<std::size_t>(i);
         const typename Ops::V xNew = Ops::blockTimes(dinv + 9 * static_cast<std::size_t>(i), y);
@@ -48,10 +49,23 @@ inline void sweep(const GaussSeidelSweep& g) {
         // later rows subtract their part.
         Ops::store3(t + 3 * static_cast<std::size_t>(i), Ops::zero());
         const typename Ops::B xb = Ops::broadcast(xNew);
-        for (int k = start[i]; k < end; ++k) {
+        for (int k = start[i]; k < last; ++k) {
             double* tj = t + 3 * static_cast<std::size_t>(cols[k]);
             Ops::store3(tj, Ops::sub(Ops::load3(tj), Ops::block(val + 9 * static_cast<std::size_t>(mirror[k]), xb)));
         }
+    }
+}
+
+// t_i = −Σ_{k > diag[i]} A_ik x_k for the rows [i0, i1) (see bsrUpperResidualRows).
+template <class Ops>
+inline void upperResidualRows(const BsrPattern& m, const float* val, const double* x, double* t,
+                              std::size_t i0, std::size_t i1) {
+    for (std::size_t i = i0; i < i1; ++i) {
+        typename Ops::V s = Ops::zero();
+        for (int k = m.diag[i] + 1; k < m.start[i + 1]; ++k)
+            s = Ops::sub(s, Ops::block(val + 9 * static_cast<std::size_t>(k),
+                                       x + 3 * static_cast<std::size_t>(m.cols[k])));
+        Ops::store3(t + 3 * i, s);
     }
 }
 

@@ -7,11 +7,41 @@
 #include "solver/cloth.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace gale::solver {
 
 namespace {
+// Meshes with fewer elements assemble on the calling thread alone (the same bits).
+constexpr size_t kParallelElements = 2048;
+
+// Elements (triangles, hinges) per block of the parallel assembly order.
+constexpr int kElementBlock = 128;
+
+// The parallel assembly order (types.h, ColouredBlocks) of elements with K corners:
+// consecutive blocks of elements, two blocks neighbours when they share a vertex, so that the
+// blocks of one colour write disjoint vertices and matrix slots.
+template <size_t K, class Corners>
+ColouredBlocks colourElements(size_t count, size_t vertices, Corners corners) {
+    const int n = static_cast<int>(count);
+    std::vector<std::vector<int>> blocksAt(vertices); // vertex → the blocks touching it
+    for (int e = 0; e < n; ++e) {
+        const std::array<int, K>& c = corners(e);
+        for (int v : c)
+            if (blocksAt[v].empty() || blocksAt[v].back() != e / kElementBlock)
+                blocksAt[v].push_back(e / kElementBlock);
+    }
+    std::vector<std::vector<int>> near((n + kElementBlock - 1) / kElementBlock);
+    for (const std::vector<int>& bs : blocksAt)
+        for (int b : bs) near[b].insert(near[b].end(), bs.begin(), bs.end());
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    return colourBlocks(n, kElementBlock, near);
+}
+
 VecX flatten(const std::vector<double>& p) { return Eigen::Map<const VecX>(p.data(), p.size()); }
 
 // Adds a triangle's nine blocks (a, b) = cK·K_ab + D9 to A: K from the membrane factors m (null:
@@ -138,82 +168,116 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
     if (out.aero) out.aero->assign(aeroMatrix ? nt : 0, AeroCoupling{}); // one slot per triangle
-    bool skewed = false; // any triangle with a skew part
-    MembraneFactors m;
+    std::atomic<bool> skewedAll{false}; // any triangle with a skew part
+    // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
+    // they share no vertex, so each vertex and slot receives its terms in the same order on any
+    // number of threads; energies summed per triangle in triangle order.
+    if (mTriBlocks.order.size() != nt)
+        mTriBlocks = colourElements<3>(nt, vertexCount(), [&](int e) -> const std::array<int, 3>& {
+            return mMesh.triangles[e];
+        });
+    mTriEnergy.resize(nt);
     const Mat3 zero = Mat3::Zero();
+    std::atomic<int> clampedAll{0};
+    auto triangles = [&](size_t s0, size_t s1) {
+        MembraneFactors m;
+        int clamped = 0;
+        for (size_t s = s0; s < s1; ++s) {
+            const size_t e = static_cast<size_t>(mTriBlocks.order[s]);
+            const auto& tri = mMesh.triangles[e];
+            const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
+            const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
+            Vec3 f3 = Vec3::Zero(); // F/3 per corner
+            Mat3 hD9;               // (h/9)·D
+            bool withD = false;
+            if (aero) {
+                const Vec3 areaNormal = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]);
+                const Vec3 wind =
+                    (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) /
+                    3.0;
+                const Vec3 u = (vel[0] + vel[1] + vel[2]) / 3.0;
+                const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
+                const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
+                const AeroResult r = aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd,
+                                                  mMat.aeroModel, in.aeroJacobian);
+                clamped += r.clamped ? 1 : 0;
+                f3 = r.force / 3.0;
+                if (aeroMatrix) {
+                    hD9 = (h / 9.0) * r.damping;
+                    withD = true;
+                    if (out.aero)
+                        (*out.aero)[e] = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
+                    if (r.skewAxis.squaredNorm() > 0.0) skewedAll.store(true, std::memory_order_relaxed);
+                }
+            }
+            const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
+            mTriEnergy[e] = membrane ? m.energy : 0.0;
+            if (membrane) {
+                // (K v)_a = a_a S_u ẇ_u + b_a S_v ẇ_v + c (Σ_j s_j·v_j) s_a (elastic.h).
+                const Vec3 Swu = m.Su * (m.a[0] * vel[0] + m.a[1] * vel[1] + m.a[2] * vel[2]);
+                const Vec3 Swv = m.Sv * (m.b[0] * vel[0] + m.b[1] * vel[1] + m.b[2] * vel[2]);
+                const double sv =
+                    m.shear * (m.s[0].dot(vel[0]) + m.s[1].dot(vel[1]) + m.s[2].dot(vel[2]));
+                for (int a = 0; a < 3; ++a) {
+                    const Vec3 kva = m.a[a] * Swu + m.b[a] * Swv + sv * m.s[a];
+                    f.segment<3>(3 * tri[a]) += m.f[a] - beta * kva + f3;
+                    if (kv) kv->segment<3>(3 * tri[a]) += kva;
+                }
+            } else if (aero) {
+                for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
+            }
+            if (A && (membrane || withD))
+                addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK,
+                                  withD ? hD9 : zero);
+        }
+        if (clamped) clampedAll.fetch_add(clamped, std::memory_order_relaxed);
+    };
+    forEachColour(mTriBlocks, false, nt >= kParallelElements && arenaConcurrency() >= 2, triangles);
+    out.clamped += clampedAll.load();
     double energy = 0.0; // (locals: `out` may alias f for all the compiler knows)
-    int clamped = 0;
-    for (size_t e = 0; e < nt; ++e) {
-        const auto& tri = mMesh.triangles[e];
-        const Vec3 p[3] = {vec3At(in.x, tri[0]), vec3At(in.x, tri[1]), vec3At(in.x, tri[2])};
-        const Vec3 vel[3] = {vec3At(in.v, tri[0]), vec3At(in.v, tri[1]), vec3At(in.v, tri[2])};
-        Vec3 f3 = Vec3::Zero(); // F/3 per corner
-        Mat3 hD9;               // (h/9)·D
-        bool withD = false;
-        if (aero) {
-            const Vec3 areaNormal = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]);
-            const Vec3 wind =
-                (vec3At(in.wind, tri[0]) + vec3At(in.wind, tri[1]) + vec3At(in.wind, tri[2])) / 3.0;
-            const Vec3 u = (vel[0] + vel[1] + vel[2]) / 3.0;
-            const double cl = std::max(0.0, paintL ? cl0 * mTriLift[e] : cl0);
-            const double cd = std::max(0.0, paintD ? cd0 * mTriDrag[e] : cd0);
-            const AeroResult r =
-                aeroTriangle(wind - u, areaNormal, in.airDensity, cl, cd, mMat.aeroModel, in.aeroJacobian);
-            clamped += r.clamped ? 1 : 0;
-            f3 = r.force / 3.0;
-            if (aeroMatrix) {
-                hD9 = (h / 9.0) * r.damping;
-                withD = true;
-                if (out.aero)
-                    (*out.aero)[e] = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
-                skewed = skewed || r.skewAxis.squaredNorm() > 0.0;
-            }
-        }
-        const bool membrane = membraneFactors(mMembrane[e], p, ks, ksh, m);
-        if (membrane) {
-            energy += m.energy;
-            // (K v)_a = a_a S_u ẇ_u + b_a S_v ẇ_v + c (Σ_j s_j·v_j) s_a (elastic.h).
-            const Vec3 Swu = m.Su * (m.a[0] * vel[0] + m.a[1] * vel[1] + m.a[2] * vel[2]);
-            const Vec3 Swv = m.Sv * (m.b[0] * vel[0] + m.b[1] * vel[1] + m.b[2] * vel[2]);
-            const double sv = m.shear * (m.s[0].dot(vel[0]) + m.s[1].dot(vel[1]) + m.s[2].dot(vel[2]));
-            for (int a = 0; a < 3; ++a) {
-                const Vec3 kva = m.a[a] * Swu + m.b[a] * Swv + sv * m.s[a];
-                f.segment<3>(3 * tri[a]) += m.f[a] - beta * kva + f3;
-                if (kv) kv->segment<3>(3 * tri[a]) += kva;
-            }
-        } else if (aero) {
-            for (int a = 0; a < 3; ++a) f.segment<3>(3 * tri[a]) += f3;
-        }
-        if (A && (membrane || withD))
-            addTriangleBlocks(*A, mTriSlots[e].data(), membrane ? &m : nullptr, cK, withD ? hD9 : zero);
-    }
-    out.clamped += clamped;
-    out.skewed = out.skewed || skewed;
+    for (size_t e = 0; e < nt; ++e) energy += mTriEnergy[e];
+    out.skewed = out.skewed || skewedAll.load();
 
-    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale.
+    // Bending: constant Hessian Q = c k kᵀ ⊗ I per hinge, c = k_b·scale; hinges in coloured
+    // blocks like the triangles, energies summed per hinge in hinge order.
     if (kb != 0.0) {
-        for (size_t hi = 0; hi < mHinges.size(); ++hi) {
-            const HingeRest& r = mHingeRest[hi];
-            if (!(r.scale > 0.0)) continue;
-            const auto& v = mHinges[hi].v;
-            const double c = kb * r.scale;
-            Vec3 s = Vec3::Zero(), sv = Vec3::Zero();
-            for (int a = 0; a < 4; ++a) {
-                s += r.k[a] * vec3At(in.x, v[a]);
-                sv += r.k[a] * vec3At(in.v, v[a]);
+        const size_t nh = mHinges.size();
+        if (mHingeBlocks.order.size() != nh)
+            mHingeBlocks =
+                colourElements<4>(nh, vertexCount(),
+                                  [&](int e) -> const std::array<int, 4>& { return mHinges[e].v; });
+        mHingeEnergy.resize(nh);
+        auto hinges = [&](size_t s0, size_t s1) {
+            for (size_t q = s0; q < s1; ++q) {
+                const size_t hi = static_cast<size_t>(mHingeBlocks.order[q]);
+                const HingeRest& r = mHingeRest[hi];
+                mHingeEnergy[hi] = 0.0;
+                if (!(r.scale > 0.0)) continue;
+                const auto& v = mHinges[hi].v;
+                const double c = kb * r.scale;
+                Vec3 s = Vec3::Zero(), sv = Vec3::Zero();
+                for (int a = 0; a < 4; ++a) {
+                    s += r.k[a] * vec3At(in.x, v[a]);
+                    sv += r.k[a] * vec3At(in.v, v[a]);
+                }
+                mHingeEnergy[hi] = 0.5 * c * s.squaredNorm();
+                // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.
+                const Vec3 fs = c * (s + beta * sv), fv = c * sv;
+                for (int a = 0; a < 4; ++a) {
+                    f.segment<3>(3 * v[a]) -= r.k[a] * fs;
+                    if (kv) kv->segment<3>(3 * v[a]) += r.k[a] * fv;
+                }
             }
-            energy += 0.5 * c * s.squaredNorm();
-            // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.
-            const Vec3 fs = c * (s + beta * sv), fv = c * sv;
-            for (int a = 0; a < 4; ++a) {
-                f.segment<3>(3 * v[a]) -= r.k[a] * fs;
-                if (kv) kv->segment<3>(3 * v[a]) += r.k[a] * fv;
-            }
-        }
+        };
+        forEachColour(mHingeBlocks, false, nh >= kParallelElements && arenaConcurrency() >= 2,
+                      hinges);
+        for (size_t hi = 0; hi < nh; ++hi) energy += mHingeEnergy[hi];
         // Σ over hinges of cK·Q, summed per slot at setup (mBendCoef).
         if (A)
-            for (size_t k = 0; k < mBendSlots.size(); ++k)
-                A->addDiagonal(mBendSlots[k], cK * kb * mBendCoef[k]);
+            parallelChunks(mBendSlots.size(), 4096, [&](size_t k0, size_t k1) {
+                for (size_t k = k0; k < k1; ++k)
+                    A->addDiagonal(mBendSlots[k], cK * kb * mBendCoef[k]);
+            });
     }
     out.elasticEnergy += energy;
 }

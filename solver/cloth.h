@@ -52,6 +52,10 @@ private:
     std::vector<int> mBendSlots;    // matrix slots the hinges touch
     std::vector<double> mBendCoef;  // per slot: Σ over hinges of scale·k_a·k_b (bending Hessian / k_b)
     std::vector<double> mTriLift, mTriDrag; // mean painted map value per triangle (or empty)
+    // Parallel assembly (built on the first addForces): blocks of triangles and of hinges, no
+    // two blocks of a colour sharing a vertex (types.h).
+    ColouredBlocks mTriBlocks, mHingeBlocks;
+    std::vector<double> mTriEnergy, mHingeEnergy; // per element, summed in element order
     int mDegenerate = 0;
 };
 

@@ -348,12 +348,13 @@ double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool si
 // checked against Â in double (r = rhs − Â y); should that residual miss the tolerance, CG
 // restarts from y with double-precision products (residual replacement). The reported
 // residual is always the double-precision one.
-SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
-                                              VecX& y, double tolerance, int maxIterations) {
+SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constraints& c,
+                                              const VecX& rhsNatural, VecX& yNatural,
+                                              double tolerance, int maxIterations) {
     SolveStatus st;
     const size_t n3 = 3 * static_cast<size_t>(A.size());
-    const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
-    if (trivialRhs(rhsNorm, y, st)) return st;
+    const double rhsNorm = std::sqrt(deterministicDot(rhsNatural.data(), rhsNatural.data(), n3));
+    if (trivialRhs(rhsNorm, yNatural, st)) return st;
     if (!mMultigrid.refresh(A, c, mConstrained)) {
         st.failed = true;
         return st;
@@ -362,6 +363,13 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     mZ.resize(n3);
     mP.resize(n3);
     mQ.resize(n3);
+    // CG runs in the multigrid's level-0 (colour) order: rhs and y permuted in, y out.
+    mRhsLevel.resize(n3);
+    mYLevel.resize(n3);
+    mMultigrid.toLevelOrder(rhsNatural.data(), mRhsLevel.data());
+    mMultigrid.toLevelOrder(yNatural.data(), mYLevel.data());
+    const VecX& rhs = mRhsLevel;
+    VecX& y = mYLevel;
     const double target = tolerance * rhsNorm;
     // r = rhs − Â y (the products in double unless `single`); returns ‖r‖.
     auto residual = [&](bool single) {
@@ -379,6 +387,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
         if (!(rNorm <= target) && it < maxIterations)
             rNorm = multigridCg(y, rNorm, target, false, maxIterations, it, st);
     }
+    mMultigrid.fromLevelOrder(y.data(), yNatural.data());
     st.iterations = it;
     st.residual = rNorm / rhsNorm;
     st.converged = rNorm <= target;

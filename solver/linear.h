@@ -141,6 +141,7 @@ private:
     Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
     BlockMultigrid mMultigrid;
     VecX mTmp2, mR, mZ, mP, mQ;
+    VecX mRhsLevel, mYLevel; // multigrid PCG's rhs and y in the multigrid's level-0 order
     std::vector<double> mPartial;
     std::vector<int> mConstrained; // vertices with S ≠ I
     std::vector<Mat3> mPrecond;

@@ -10,8 +10,10 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace gale::solver {
 
@@ -20,6 +22,40 @@ namespace {
 // Blocks are stored column-major, 9 values each (bsr_kernels.h).
 using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
+
+// The multicolour ordering of a level (types.h, ColouredBlocks): its rows, in natural order, cut
+// into blocks of `rowBlock`; two blocks neighbour when a row of one shares a matrix block
+// with a row of the other. Without `multicolour`: the natural order, one block.
+ColouredBlocks colourRows(bool multicolour, int rowBlock, int n, const int* start,
+                          const int* cols) {
+    if (!multicolour || rowBlock <= 0 || n <= rowBlock) return naturalBlocks(n);
+    std::vector<std::vector<int>> near((n + rowBlock - 1) / rowBlock);
+    for (int i = 0; i < n; ++i) {
+        std::vector<int>& nb = near[i / rowBlock];
+        for (int k = start[i]; k < start[i + 1]; ++k)
+            if (cols[k] / rowBlock != i / rowBlock) nb.push_back(cols[k] / rowBlock);
+    }
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    return colourBlocks(n, rowBlock, near);
+}
+
+int slotIn(const BsrMatrix& m, int i, int j) {
+    auto b = m.cols.begin() + m.start[i], e = m.cols.begin() + m.start[i + 1];
+    return static_cast<int>(std::lower_bound(b, e, j) - m.cols.begin());
+}
+
+// diag and mirror of a pattern with sorted columns, symmetric, the diagonal present.
+void finishPattern(BsrMatrix& m) {
+    m.diag.resize(m.n);
+    m.mirror.resize(m.cols.size());
+    for (int i = 0; i < m.n; ++i) {
+        m.diag[i] = slotIn(m, i, i);
+        for (int k = m.start[i]; k < m.start[i + 1]; ++k) m.mirror[k] = slotIn(m, m.cols[k], i);
+    }
+}
 
 } // namespace
 
@@ -57,32 +93,59 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: set-up
 
+BlockMultigrid::Settings& BlockMultigrid::defaults() {
+    static Settings settings;
+    return settings;
+}
+
+// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
+// slot k holds A's slot mSrcSlot[k]).
 void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     mLevels.assign(1, Level());
-    BsrMatrix& a = mLevels[0].a;
-    a.n = A.size();
-    a.start = A.blockRowStart();
-    a.cols = A.blockCols();
-    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
-    a.diag.resize(a.n);
-    a.mirror.resize(a.cols.size());
-    for (int i = 0; i < a.n; ++i) {
-        a.diag[i] = A.diagonalSlot(i);
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) a.mirror[k] = A.mirrorSlot(k);
+    Level& L = mLevels[0];
+    BsrMatrix& a = L.a;
+    const int n = A.size();
+    const std::vector<int>& start = A.blockRowStart();
+    const std::vector<int>& cols = A.blockCols();
+    L.colouring =
+        colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
+    mOrder = L.colouring.order;
+    L.visit.resize(n);
+    for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
+    a.n = n;
+    a.start.assign(n + 1, 0);
+    a.cols.clear();
+    mSrcSlot.clear();
+    std::vector<std::pair<int, int>> row; // (level-0 column, A's slot)
+    for (int p = 0; p < n; ++p) {
+        const int i = mOrder[p];
+        row.clear();
+        for (int k = start[i]; k < start[i + 1]; ++k) row.push_back({L.visit[cols[k]], k});
+        std::sort(row.begin(), row.end());
+        for (const auto& e : row) {
+            a.cols.push_back(e.first);
+            mSrcSlot.push_back(e.second);
+        }
+        a.start[p + 1] = static_cast<int>(a.cols.size());
     }
+    finishPattern(a);
+    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
     mPatternRows = A.size();
     mPatternSlots = A.slotCount();
 }
 
 // Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
-// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit);
-// builds the pattern of `coarse` and the slot map.
+// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit),
+// rows visited in their natural order (fine.visit); builds the pattern of `coarse` — its rows
+// (the aggregates, numbered in the order they were found) coloured and renumbered in colour
+// order — and the slot maps.
 void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
     const BsrMatrix& a = fine.a;
     const int n = a.n;
     std::vector<int> agg(n, -1), size;
     // 1. Roots: a vertex whose neighbours are all unaggregated starts an aggregate with them.
-    for (int i = 0; i < n; ++i) {
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
         if (agg[i] >= 0) continue;
         bool free = true;
         for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
@@ -104,14 +167,34 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
     }
     // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
     int count = static_cast<int>(size.size());
-    for (int i = 0; i < n; ++i) {
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
         if (joined[i] >= 0) continue;
         joined[i] = count;
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
             if (joined[a.cols[k]] < 0) joined[a.cols[k]] = count;
         ++count;
     }
-    fine.agg = std::move(joined);
+    // The coarse graph in the aggregates' natural numbering, coloured in that order; coarse
+    // row P is aggregate order[P].
+    std::vector<std::vector<int>> rows(count);
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            rows[joined[i]].push_back(joined[a.cols[k]]);
+    std::vector<int> natStart(count + 1, 0), natCols;
+    for (int I = 0; I < count; ++I) {
+        std::sort(rows[I].begin(), rows[I].end());
+        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
+        natCols.insert(natCols.end(), rows[I].begin(), rows[I].end());
+        natStart[I + 1] = static_cast<int>(natCols.size());
+    }
+    coarse.colouring = colourRows(mSettings.multicolour, mSettings.rowBlock, count, natStart.data(),
+                                  natCols.data());
+    const std::vector<int>& order = coarse.colouring.order;
+    coarse.visit.resize(count);
+    for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
+    fine.agg.resize(n);
+    for (int i = 0; i < n; ++i) fine.agg[i] = coarse.visit[joined[i]];
     fine.memberStart.assign(count + 1, 0);
     for (int i = 0; i < n; ++i) ++fine.memberStart[fine.agg[i] + 1];
     for (int I = 0; I < count; ++I) fine.memberStart[I + 1] += fine.memberStart[I];
@@ -120,35 +203,34 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
         std::vector<int> fill(fine.memberStart.begin(), fine.memberStart.end() - 1);
         for (int i = 0; i < n; ++i) fine.members[fill[fine.agg[i]]++] = i;
     }
-    // Coarse pattern: (agg i, agg j) for every fine block (i, j).
-    std::vector<std::vector<int>> rows(count);
-    for (int i = 0; i < n; ++i)
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) rows[fine.agg[i]].push_back(fine.agg[a.cols[k]]);
+    // Coarse pattern: (agg i, agg j) for every fine block (i, j), in the coarse numbering.
     BsrMatrix& c = coarse.a;
     c.n = count;
     c.start.assign(count + 1, 0);
     c.cols.clear();
-    for (int I = 0; I < count; ++I) {
-        std::sort(rows[I].begin(), rows[I].end());
-        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
-        c.cols.insert(c.cols.end(), rows[I].begin(), rows[I].end());
-        c.start[I + 1] = static_cast<int>(c.cols.size());
+    std::vector<int> row;
+    for (int P = 0; P < count; ++P) {
+        row.clear();
+        for (int k = natStart[order[P]]; k < natStart[order[P] + 1]; ++k)
+            row.push_back(coarse.visit[natCols[k]]);
+        std::sort(row.begin(), row.end());
+        c.cols.insert(c.cols.end(), row.begin(), row.end());
+        c.start[P + 1] = static_cast<int>(c.cols.size());
     }
-    auto slotOf = [&](int I, int J) {
-        auto b = c.cols.begin() + c.start[I], e = c.cols.begin() + c.start[I + 1];
-        return static_cast<int>(std::lower_bound(b, e, J) - c.cols.begin());
-    };
-    c.diag.resize(count);
-    c.mirror.resize(c.cols.size());
-    for (int I = 0; I < count; ++I) {
-        c.diag[I] = slotOf(I, I);
-        for (int k = c.start[I]; k < c.start[I + 1]; ++k) c.mirror[k] = slotOf(c.cols[k], I);
-    }
+    finishPattern(c);
     c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
     fine.coarseSlot.resize(a.cols.size());
     for (int i = 0; i < n; ++i)
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
-            fine.coarseSlot[k] = slotOf(fine.agg[i], fine.agg[a.cols[k]]);
+            fine.coarseSlot[k] = slotIn(c, fine.agg[i], fine.agg[a.cols[k]]);
+    // The same map inverted, for the coarsening's gather: the fine slots of each coarse slot in
+    // increasing order.
+    fine.gatherStart.assign(c.cols.size() + 1, 0);
+    for (int K : fine.coarseSlot) ++fine.gatherStart[K + 1];
+    for (size_t K = 0; K < c.cols.size(); ++K) fine.gatherStart[K + 1] += fine.gatherStart[K];
+    fine.gather.resize(a.cols.size());
+    std::vector<int> fill(fine.gatherStart.begin(), fine.gatherStart.end() - 1);
+    for (int k = 0; k < a.blocks(); ++k) fine.gather[fill[fine.coarseSlot[k]]++] = k;
 }
 
 // A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
@@ -156,13 +238,18 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
 void BlockMultigrid::coarsen(int l) {
     Level& f = mLevels[l];
     BsrMatrix& c = mLevels[l + 1].a;
-    std::fill(c.val.begin(), c.val.end(), 0.0);
     const BsrMatrix& a = f.a;
-    for (int k = 0; k < a.blocks(); ++k) {
-        double* __restrict dst = c.val.data() + 9 * static_cast<size_t>(f.coarseSlot[k]);
-        const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(k);
-        for (int q = 0; q < 9; ++q) dst[q] += src[q];
-    }
+    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
+    parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
+        for (int K = c.start[I0]; K < c.start[I1]; ++K) {
+            double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+            for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
+                const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
+                for (int q = 0; q < 9; ++q) sum[q] += src[q];
+            }
+            std::copy(sum, sum + 9, c.val.data() + 9 * static_cast<size_t>(K));
+        }
+    });
     if (l != 0 || mKind.empty()) return;
     for (int i = 0; i < a.n; ++i) {
         if (!mKind[i]) continue;
@@ -196,29 +283,36 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     // Level 0: Â = S A S + I − S.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
-    // One pass over A (the same layout, pad included): the double copy, its single-precision
+    // One pass over A, rows in parallel: the double copy in level-0 order, its single-precision
     // twin for the smoother and the CG products, and the finiteness check.
     std::vector<float>& low = mLevels[0].lowVal;
     low.resize(a.val.size());
-    {
+    std::fill(low.end() - kBsrPad, low.end(), 0.0f);
+    std::atomic<uint32_t> anyBad{0};
+    parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
         const double* __restrict src = A.values();
         double* __restrict dst = a.val.data();
         float* __restrict lo = low.data();
-        for (size_t k = 0; k < a.val.size(); ++k) {
-            dst[k] = src[k];
-            lo[k] = static_cast<float>(src[k]);
+        const int k0 = a.start[i0], k1 = a.start[i1];
+        for (int k = k0; k < k1; ++k) {
+            const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
+            for (int q = 0; q < 9; ++q) {
+                dst[9 * static_cast<size_t>(k) + q] = s[q];
+                lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
+            }
         }
-    }
-    // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or a
-    // value beyond float range, which the smoother could not use either); integer bit tests
-    // vectorise where isfinite on doubles does not.
-    uint32_t bad = 0;
-    for (const float& v : low) {
-        uint32_t bits;
-        std::memcpy(&bits, &v, sizeof bits);
-        bad |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
-    }
-    if (bad) return false;
+        // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or
+        // a value beyond float range, which the smoother could not use either); integer bit
+        // tests vectorise where isfinite on doubles does not.
+        uint32_t bad = 0;
+        for (size_t q = 9 * static_cast<size_t>(k0); q < 9 * static_cast<size_t>(k1); ++q) {
+            uint32_t bits;
+            std::memcpy(&bits, lo + q, sizeof bits);
+            bad |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+        }
+        if (bad) anyBad.fetch_or(1u, std::memory_order_relaxed);
+    });
+    if (anyBad.load()) return false;
     auto lower = [&](int k) {
         for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
             low[q] = static_cast<float>(a.val[q]);
@@ -227,11 +321,13 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     if (!constrained.empty()) {
         mKind.assign(n, 0);
         mNormal.assign(3 * static_cast<size_t>(n), 0.0);
-        for (int i : constrained) {
-            mKind[i] = cons.kind[i];
-            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * i + q];
+        for (int v : constrained) { // A's row v is level-0 row visit[v]
+            const int i = mLevels[0].visit[v];
+            mKind[i] = cons.kind[v];
+            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
         }
-        for (int i : constrained) {
+        for (int v : constrained) {
+            const int i = mLevels[0].visit[v];
             const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                 BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
@@ -266,14 +362,17 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             L.lowVal.resize(L.a.val.size());
             for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
         }
-        L.dinv.assign(9 * static_cast<size_t>(L.a.n) + kBsrPad, 0.0);
+        L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
+        std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
         // The inverse of the single-precision diagonal, so that every sweep reads one matrix
         // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
-        for (int i = 0; i < L.a.n; ++i) {
-            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
-            BlockMap(L.dinv.data() + 9 * static_cast<size_t>(i)) =
-                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
-        }
+        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) {
+                const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+                BlockMap(L.dinv.data() + 9 * i) =
+                    invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
+            }
+        });
         const size_t n3 = 3 * static_cast<size_t>(L.a.n);
         L.r.resize(n3);
         L.x.resize(n3);
@@ -313,7 +412,26 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
         g.t = residual ? L.t.data() : nullptr;
         g.forward = forward;
         g.fromZero = fromZero && forward;
-        gaussSeidelSweep(g);
+        const bool parallel =
+            n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
+        // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
+        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
+        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
+        // the same sums in the same order.
+        if (parallel) g.t = nullptr;
+        forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
+            GaussSeidelSweep part = g;
+            part.begin = static_cast<int>(i0);
+            part.end = static_cast<int>(i1);
+            gaussSeidelSweep(part);
+        });
+        if (!parallel) return;
+        if (residual && g.fromZero) {
+            const BsrPattern p = a.pattern();
+            parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
+                bsrUpperResidualRows(p, L.lowVal.data(), x, L.t.data(), i0, i1);
+            });
+        }
         return;
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).
@@ -382,6 +500,22 @@ void BlockMultigrid::cycle(int l) {
         }
     });
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+}
+
+void BlockMultigrid::toLevelOrder(const double* natural, double* level) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                level[3 * p + q] = natural[3 * static_cast<size_t>(mOrder[p]) + q];
+    });
+}
+
+void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                natural[3 * static_cast<size_t>(mOrder[p]) + q] = level[3 * p + q];
+    });
 }
 
 double BlockMultigrid::apply(const double* r, double* z) {

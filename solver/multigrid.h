@@ -46,10 +46,26 @@ struct BsrMatrix {
 // neighbours, then the rest joined to a neighbouring aggregate) are chosen once per matrix
 // pattern, from the pattern alone; every later refresh only re-sums the values.
 // The V-cycle uses damped block-Jacobi smoothing (ν sweeps before and the same after) or a
-// forward/backward block Gauss–Seidel pair, and a dense Cholesky on the coarsest level, so
-// the preconditioner is symmetric positive definite. The smoother reads a single-precision copy
-// of each level's matrix (half the memory traffic; the V-cycle only approximates Â⁻¹ anyway),
-// while conjugate gradient multiplies with Â in double precision.
+// forward/backward multicolour block Gauss–Seidel pair, and a dense Cholesky on the coarsest
+// level, so the preconditioner is symmetric positive definite.
+//
+// Multicolour ordering (Adams 2001, "A distributed memory unstructured Gauss–Seidel algorithm
+// for multigrid smoothers"; Saad, "Iterative Methods for Sparse Linear Systems" §12.4, here
+// by blocks of rows): each level's rows, in natural order, are cut into blocks of
+// Settings::rowBlock, the blocks coloured greedily in block order so that no two blocks of a
+// colour are coupled, and the level is stored renumbered colour by colour (blocks and rows in
+// natural order within a colour). Gauss–Seidel in that row order is lexicographic inside a
+// block and multicolour between blocks: the blocks of one colour read only the other colours'
+// x, so they are swept in parallel and the result is the same bits on any number of threads
+// (and the same as the one sequential sweep small levels take). The backward sweep visits the
+// colours in reverse, each block backwards: it stays the exact adjoint of the forward one.
+// Whole blocks keep the natural order's memory locality and most of its coupling, so the
+// smoother is nearly as strong as the lexicographic one (bench/README.md). Aggregation visits
+// the rows in their natural order, so the renumbering does not change the aggregates. Vectors
+// passed to apply, multiply and
+// multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder). The smoother reads a
+// single-precision copy of each level's matrix (half the memory traffic; the V-cycle only
+// approximates Â⁻¹ anyway), while conjugate gradient multiplies with Â in double precision.
 class BlockMultigrid {
 public:
     struct Settings {
@@ -58,13 +74,29 @@ public:
         double jacobiWeight = 0.6;  // ω of damped block Jacobi
         double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
         int coarsest = 48;          // stop coarsening at this many block rows
+        int parallelRows = 1024;    // levels with fewer rows sweep sequentially (the same bits)
+        int rowBlock = 128;         // rows per block of the multicolour ordering
+        bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
+                                    // always sequential (the benchmark's baseline)
     };
+
+    // The settings new instances start with (process-wide, like setWideKernels: change them
+    // only while no solver is being built; the benchmark compares orderings with it).
+    static Settings& defaults();
 
     Settings& settings() { return mSettings; }
 
-    // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates are built
-    // when the pattern of A is new. Returns false when a value is not finite.
+    // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
+    // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
+    // when a value is not finite.
     bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained);
+    // 3n vectors from A's vertex order to level 0's colour order and back.
+    void toLevelOrder(const double* natural, double* level) const;
+    void fromLevelOrder(const double* level, double* natural) const;
+    // A level's matrix (in its colour order) and its multicolour ordering (its order lists the
+    // natural index of each row).
+    const BsrMatrix& matrix(int level) const { return mLevels[level].a; }
+    const ColouredBlocks& colouring(int level) const { return mLevels[level].colouring; }
     // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero); returns rᵀz
     // summed as deterministicDot does (fused with the copy-out).
     double apply(const double* r, double* z);
@@ -87,6 +119,10 @@ private:
         std::vector<int> agg;          // aggregate (row of the next level) per row
         std::vector<int> memberStart, members; // rows of each aggregate
         std::vector<int> coarseSlot;   // slot of the next level's matrix per slot
+        std::vector<int> gatherStart,
+            gather;                    // per slot of the next level: the slots summed into it
+        ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
+        std::vector<int> visit;        // row of each natural index (the aggregation's order)
         std::vector<double> r, x, t;   // 3n work vectors
     };
 
@@ -97,10 +133,12 @@ private:
     void smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
 
-    Settings mSettings;
+    Settings mSettings = defaults();
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
     std::vector<double> mPartial; // chunk sums of the fused dot products
+    std::vector<int> mOrder;      // A's row of each level-0 row
+    std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -219,20 +220,98 @@ TEST_CASE("multigrid: the scene key picks the preconditioner; a bad value is an 
     std::remove(path.c_str());
 }
 
-TEST_CASE("multigrid: PCG gives the same bits on 1 and 3 threads", "[multigrid]") {
+TEST_CASE("multigrid: PCG gives the same bits on 1, 2 and 3 threads", "[multigrid]") {
+    // parallelRows 0: every level sweeps colour by colour in parallel chunks (on more than one
+    // thread); the default sweeps the small coarse levels sequentially. All the same bits.
     Sheet s = makeSheet(64, true);
     VecX ref;
-    for (int threads : {1, 3}) {
-        tbb::task_arena arena(threads);
-        VecX x = VecX::Zero(s.b.size());
-        arena.execute([&] {
-            FilteredSolver mg;
-            mg.setPreconditioner(Preconditioner::Multigrid);
-            REQUIRE(mg.solve(s.A, s.c, s.b, x, LinearSolverKind::Pcg, 1e-8, 500).converged);
-        });
-        if (threads == 1)
-            ref = x;
-        else
-            CHECK((x - ref).cwiseAbs().maxCoeff() == 0.0);
+    for (int parallelRows : {1024, 0})
+        for (int threads : {1, 2, 3}) {
+            tbb::task_arena arena(threads);
+            VecX x = VecX::Zero(s.b.size());
+            arena.execute([&] {
+                FilteredSolver mg;
+                mg.setPreconditioner(Preconditioner::Multigrid);
+                mg.multigrid().settings().parallelRows = parallelRows;
+                REQUIRE(mg.solve(s.A, s.c, s.b, x, LinearSolverKind::Pcg, 1e-8, 500).converged);
+            });
+            INFO(threads << " threads, parallelRows " << parallelRows);
+            if (ref.size() == 0)
+                ref = x;
+            else
+                CHECK((x - ref).cwiseAbs().maxCoeff() == 0.0);
+        }
+}
+
+TEST_CASE("multigrid: each level's colours are independent sets", "[multigrid]") {
+    Sheet s = makeSheet(48, true);
+    BlockMultigrid mg;
+    REQUIRE(mg.refresh(s.A, s.c, s.constrained));
+    REQUIRE(mg.levelCount() >= 3);
+    // The level-0 order is a permutation of A's vertices.
+    const int n3 = 3 * s.A.size();
+    VecX natural(n3), level(n3), back(n3);
+    for (int q = 0; q < n3; ++q) natural[q] = q;
+    mg.toLevelOrder(natural.data(), level.data());
+    mg.fromLevelOrder(level.data(), back.data());
+    CHECK(back == natural);
+    std::vector<int> seen(s.A.size(), 0);
+    for (int p = 0; p < s.A.size(); ++p) ++seen[static_cast<int>(level[3 * p]) / 3];
+    CHECK(std::count(seen.begin(), seen.end(), 1) == s.A.size());
+    for (int l = 0; l < mg.levelCount(); ++l) {
+        const BsrMatrix& a = mg.matrix(l);
+        const ColouredBlocks& cb = mg.colouring(l);
+        INFO("level " << l << ": " << a.n << " rows, " << cb.blockStart.size() - 1 << " blocks, "
+                      << cb.colours() << " colours");
+        REQUIRE(cb.blockStart.back() == a.n);
+        REQUIRE(cb.colourStart.back() == static_cast<int>(cb.blockStart.size()) - 1);
+        std::vector<int> colour(a.n), block(a.n);
+        for (int c = 0; c < cb.colours(); ++c)
+            for (int bl = cb.colourStart[c]; bl < cb.colourStart[c + 1]; ++bl)
+                for (int p = cb.blockStart[bl]; p < cb.blockStart[bl + 1]; ++p)
+                    colour[p] = c, block[p] = bl;
+        int coupled = 0; // blocks of a row's colour other than its own that it is coupled to
+        for (int p = 0; p < a.n; ++p)
+            for (int k = a.start[p]; k < a.start[p + 1]; ++k) {
+                const int q = a.cols[k];
+                if (block[q] != block[p] && colour[q] == colour[p]) ++coupled;
+            }
+        CHECK(coupled == 0);
+        // Level 0 of a 48×48 sheet (blocks of 128 rows, couplings to ±49 rows): a few colours
+        // of many blocks, enough to share between threads.
+        if (l == 0) {
+            CHECK(cb.colours() >= 2);
+            CHECK(cb.colours() <= 4);
+            CHECK(cb.blockStart.size() - 1 >= 18);
+        }
     }
+}
+
+TEST_CASE("multigrid: the parallel V-cycle is symmetric and matches the sequential one",
+          "[multigrid]") {
+    Sheet s = makeSheet(40, true);
+    const int n3 = 3 * s.A.size();
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    VecX x(n3), y(n3);
+    for (int q = 0; q < n3; ++q) x[q] = u(rng), y[q] = u(rng);
+    VecX bxSeq(n3);
+    {
+        BlockMultigrid seq;
+        REQUIRE(seq.refresh(s.A, s.c, s.constrained));
+        seq.apply(x.data(), bxSeq.data());
+    }
+    tbb::task_arena arena(2);
+    arena.execute([&] {
+        BlockMultigrid mg;
+        mg.settings().parallelRows = 0;
+        REQUIRE(mg.refresh(s.A, s.c, s.constrained));
+        VecX bx(n3), by(n3);
+        mg.apply(x.data(), bx.data());
+        mg.apply(y.data(), by.data());
+        CHECK((bx - bxSeq).cwiseAbs().maxCoeff() == 0.0);
+        const double xBy = x.dot(by), yBx = y.dot(bx);
+        CHECK(std::abs(xBy - yBx) <= 1e-10 * (std::abs(xBy) + bx.norm() * y.norm()));
+        CHECK(x.dot(bx) > 0.0);
+    });
 }

@@ -93,7 +93,7 @@ TEST_CASE("robust: non-finite state that halving cannot fix fails the frame, sta
 
 TEST_CASE("robust: results do not depend on the thread count", "[robust]") {
     VecX ref;
-    for (int threads : {1, 2}) {
+    for (int threads : {1, 2, 3}) {
         WorldSettings ws;
         ws.threads = threads;
         World w(ws);

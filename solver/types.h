@@ -29,6 +29,35 @@ inline Eigen::Map<const Vec3> vec3At(const double* p, std::size_t i) {
 void parallelChunks(std::size_t n, std::size_t grain,
                     const std::function<void(std::size_t, std::size_t)>& fn);
 
+// The number of threads of the calling thread's TBB arena (1: parallelChunks runs inline).
+int arenaConcurrency();
+
+// A deterministic parallel order for a loop whose items may not run at the same time as their
+// neighbours (Gauss–Seidel rows that share a block, triangles that share a vertex): the items
+// cut into consecutive blocks of a fixed size, the blocks coloured greedily in block order (a
+// block takes the smallest colour no earlier neighbouring block holds), then listed colour by
+// colour, blocks and items in index order. Running the colours in order, the blocks of one
+// colour in parallel and each block's items in order gives every item the same inputs on any
+// number of threads — the same bits as running `order` sequentially. Consecutive blocks keep
+// the memory locality of the item order (a colour-major order of single items would scatter
+// every pass over the whole mesh).
+struct ColouredBlocks {
+    std::vector<int> order;       // the items, colour by colour
+    std::vector<int> blockStart;  // block b is order[blockStart[b] .. blockStart[b+1])
+    std::vector<int> colourStart; // colour c is blocks colourStart[c] .. colourStart[c+1]
+    int colours() const { return static_cast<int>(colourStart.size()) - 1; }
+};
+// blockNeighbours[b]: the blocks whose items neighbour an item of block b (b itself ignored).
+ColouredBlocks colourBlocks(int items, int blockSize,
+                            const std::vector<std::vector<int>>& blockNeighbours);
+// All items in one block and one colour: the plain index order.
+ColouredBlocks naturalBlocks(int items);
+// Runs fn(begin, end) over ranges of positions in cb.order covering it once: colour by colour
+// (the last colour first with `reverse`), each colour's blocks in parallel chunks; with
+// `parallel` false, or a single colour, one call fn(0, n).
+void forEachColour(const ColouredBlocks& cb, bool reverse, bool parallel,
+                   const std::function<void(std::size_t, std::size_t)>& fn);
+
 // The inverse of a 3×3 block, or I / max|d_ii| when it is singular or its inverse not finite
 // (the fallback of the block-Jacobi and multigrid smoother diagonals).
 Mat3 invertBlockOrScale(const Mat3& d);
