@@ -36,45 +36,19 @@ constexpr std::string_view kSetPrefix = "--set ";
 // implicit solver minutes a frame and gigabytes).
 constexpr long long kMaxGridVertices = 1LL << 20;
 
-const std::vector<std::string> kClothKeys = {"name",
-                                             "mesh",
-                                             "grid",
-                                             "density",
-                                             "stretch",
-                                             "shear",
-                                             "bend",
-                                             "damping",
-                                             "lift",
-                                             "drag",
-                                             "aero_model",
-                                             "aero_jacobian",
-                                             "pins",
-                                             "linear_solver",
-                                             "preconditioner",
-                                             "cg_tolerance",
-                                             "cg_max_iterations",
-                                             "newton_iterations",
-                                             "newton_tolerance",
-                                             "output"};
-const std::vector<std::string> kHairKeys = {"name",
-                                            "strands",
-                                            "grid",
-                                            "radius",
-                                            "density",
-                                            "stretch",
-                                            "bend",
-                                            "damping",
-                                            "drag_normal",
-                                            "drag_tangent",
-                                            "root_pinned",
-                                            "pins",
-                                            "linear_solver",
-                                            "preconditioner",
-                                            "cg_tolerance",
-                                            "cg_max_iterations",
-                                            "newton_iterations",
-                                            "newton_tolerance",
-                                            "output"};
+// The keys of the step options (Loader::stepOptions), shared by cloth and hair.
+std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
+    for (const char* k : {"pins", "linear_solver", "preconditioner", "cg_tolerance", "cg_max_iterations",
+                          "newton_iterations", "newton_tolerance", "output"})
+        keys.push_back(k);
+    return keys;
+}
+const std::vector<std::string> kClothKeys =
+    withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
+                  "drag", "aero_model", "aero_jacobian"});
+const std::vector<std::string> kHairKeys =
+    withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
+                  "drag_normal", "drag_tangent", "root_pinned"});
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
