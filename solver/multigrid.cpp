@@ -397,7 +397,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: the V-cycle
 
-void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
+bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     Level& L = mLevels[l];
     const BsrMatrix& a = L.a;
     const int n = a.n;
@@ -427,14 +427,7 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
             part.end = static_cast<int>(i1);
             gaussSeidelSweep(part);
         });
-        if (!parallel) return;
-        if (residual && g.fromZero) {
-            const BsrPattern p = a.pattern();
-            parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
-                bsrUpperResidualRows(p, L.lowVal.data(), x, L.t.data(), i0, i1);
-            });
-        }
-        return;
+        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).
     const double w = mSettings.jacobiWeight;
@@ -450,6 +443,7 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
             }
         }
     });
+    return false;
 }
 
 void BlockMultigrid::cycle(int l) {
@@ -471,21 +465,25 @@ void BlockMultigrid::cycle(int l) {
     // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j, which that sweep accumulates itself.
     const BsrMatrix& a = L.a;
     const bool fused = mSettings.gaussSeidel && mSettings.sweeps == 1;
-    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, true, s == 0, fused);
+    bool pull = false; // t_i = −Σ_{j>i} A_ij x_j still to be pulled, row by row
+    for (int s = 0; s < mSettings.sweeps; ++s) pull = smooth(l, true, s == 0, fused);
     if (!fused) {
         a.multiply(L.xp, L.t.data());
         for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
     }
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i.
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
     Level& C = mLevels[l + 1];
+    const BsrPattern p = a.pattern();
     const bool filtered = l == 0 && !mKind.empty();
-    parallelChunks(static_cast<size_t>(C.a.n), 256, [&](size_t I0, size_t I1) {
+    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
         for (size_t I = I0; I < I1; ++I) {
             Vec3 s = Vec3::Zero();
             for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
                 const int i = L.members[m];
+                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i]) t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                if (filtered && mKind[i])
+                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];

@@ -131,8 +131,9 @@ private:
     void buildHierarchy(const BlockMatrix& A);
     void aggregate(Level& fine, Level& coarse);
     void coarsen(int l);
-    // residual: (forward from zero only) also leave t = r − A x in L.t.
-    void smooth(int l, bool forward, bool fromZero, bool residual = false);
+    // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
+    // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
+    bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
 
     Settings mSettings = defaults();
