@@ -1,10 +1,10 @@
 // gale_bench_solver: speed against error for the implicit cloth solver, next to an explicit
 // symplectic-Euler baseline measured in the same run; cost per vertex per step and CG
 // iterations for 32², 64², 128² cloth; aero.md's edge-on stability matrix; 2 threads against 1.
-//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability|threads] [--size
-//   N]
-//   [--solver NAME]  (DIR gets CSV tables and SVG plots; --only runs one section; --size N and
-//   --solver NAME keep only those rows of the scaling table, e.g. to profile one of them)
+//   gale_bench_solver [--quick] [--out DIR] [--only plate|flag|scaling|stability|threads]
+//   [--size N] [--solver NAME] [--threads T]  (DIR gets CSV tables and SVG plots; --only runs
+//   one section; --size N and --solver NAME keep only those rows of the scaling table, --size N
+//   and --threads T only the multicolour T-thread run of the threads table, e.g. to profile one)
 #include "solver/bsr_kernels.h"
 #include "solver/cloth.h"
 #include "solver/linear.h"
@@ -425,8 +425,8 @@ void scalingBench(bool quick, int onlySize, const std::string& onlySolver) {
 // on 1 thread — the smoother before issue 14 — and the multicolour smoother on 1 and 2
 // threads. Wall time per substep (best of the repeats), CG iterations per substep, the ratios,
 // and whether the 1- and 2-thread multicolour runs ended on the same bits (they must).
-void threadsBench(bool quick, int onlySize) {
-    const int repeats = quick ? 1 : 3;
+void threadsBench(bool quick, int onlySize, int onlyThreads) {
+    const int repeats = quick ? 1 : 5;
     std::printf(
         "\n## Two threads against one (issue 14): flag 1 m, sigma 0.1 kg/m^2, stretch 2000 N/m, "
         "gusty 12 m/s, "
@@ -451,6 +451,9 @@ void threadsBench(bool quick, int onlySize) {
         VecX x[3];
         for (int rep = 0; rep < repeats; ++rep)
             for (int k = 0; k < 3; ++k) {
+                if (onlyThreads > 0 &&
+                    (!configs[k].multicolour || configs[k].threads != onlyThreads))
+                    continue;
                 BlockMultigrid::defaults().multicolour = configs[k].multicolour;
                 FlagSpec f;
                 f.n = n;
@@ -464,6 +467,11 @@ void threadsBench(bool quick, int onlySize) {
                 x[k] = r.x;
             }
         BlockMultigrid::defaults() = initial;
+        if (onlyThreads > 0) { // one configuration, for profiling
+            std::printf("| %dx%d | %d | multicolour, %d thread(s): %.2f ms/step (%.1f its) |\n", n,
+                        n, frames, onlyThreads, best[onlyThreads] * 1e3, its[onlyThreads]);
+            continue;
+        }
         const bool same = x[1].size() == x[2].size() &&
                           std::memcmp(x[1].data(), x[2].data(), sizeof(double) * x[1].size()) == 0;
         std::printf("| %dx%d | %d | %.2f (%.1f) | %.2f (%.1f) | %.2f | %.2fx | **%.2fx** (%.2fx vs "
@@ -525,17 +533,19 @@ void stabilityBench(bool quick) {
 int main(int argc, char** argv) {
     bool quick = false;
     std::string out, only;
-    int onlySize = 0;
+    int onlySize = 0, onlyThreads = 0;
     std::string onlySolver;
     const char* usage = "usage: gale_bench_solver [--quick] [--out DIR] [--only "
                         "plate|flag|scaling|stability|threads] [--size 32|64|128]\n"
-                        "       [--solver Jacobi|multigrid|direct]\n";
+                        "       [--solver Jacobi|multigrid|direct] [--threads 1|2]\n";
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
         else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
         else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) onlySize = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--solver") && i + 1 < argc) onlySolver = argv[++i];
+        else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+            onlyThreads = std::atoi(argv[++i]);
         else {
             std::fprintf(stderr, "%s", usage);
             return 2;
@@ -546,6 +556,6 @@ int main(int argc, char** argv) {
     if (only.empty() || only == "flag") flagBench(quick, out);
     if (only.empty() || only == "scaling") scalingBench(quick, onlySize, onlySolver);
     if (only.empty() || only == "stability") stabilityBench(quick);
-    if (only.empty() || only == "threads") threadsBench(quick, onlySize);
+    if (only.empty() || only == "threads") threadsBench(quick, onlySize, onlyThreads);
     return 0;
 }

@@ -376,6 +376,8 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         const size_t n3 = 3 * static_cast<size_t>(L.a.n);
         L.r.resize(n3);
         L.x.resize(n3);
+        L.rp = L.r.data();
+        L.xp = L.x.data();
         L.t.resize(n3);
     }
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
@@ -395,12 +397,12 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
 // ---------------------------------------------------------------------------------------------
 // BlockMultigrid: the V-cycle
 
-void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
+bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     Level& L = mLevels[l];
     const BsrMatrix& a = L.a;
     const int n = a.n;
-    double* x = L.x.data();
-    const double* r = L.r.data();
+    double* x = L.xp;
+    const double* r = L.rp;
     if (mSettings.gaussSeidel) {
         GaussSeidelSweep g;
         g.pattern = a.pattern();
@@ -425,14 +427,7 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
             part.end = static_cast<int>(i1);
             gaussSeidelSweep(part);
         });
-        if (!parallel) return;
-        if (residual && g.fromZero) {
-            const BsrPattern p = a.pattern();
-            parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
-                bsrUpperResidualRows(p, L.lowVal.data(), x, L.t.data(), i0, i1);
-            });
-        }
-        return;
+        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).
     const double w = mSettings.jacobiWeight;
@@ -448,6 +443,7 @@ void BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
             }
         }
     });
+    return false;
 }
 
 void BlockMultigrid::cycle(int l) {
@@ -455,34 +451,39 @@ void BlockMultigrid::cycle(int l) {
     const size_t n3 = 3 * static_cast<size_t>(L.a.n);
     if (l + 1 == static_cast<int>(mLevels.size())) {
         if (mCoarseOk) {
-            Eigen::Map<VecX>(L.x.data(), n3) = mCoarseLlt.solve(Eigen::Map<const VecX>(L.r.data(), n3));
-        } else { // a symmetric pair of sweeps
-            std::fill(L.x.begin(), L.x.end(), 0.0);
+            Eigen::Map<VecX>(L.xp, n3) = mCoarseLlt.solve(Eigen::Map<const VecX>(L.rp, n3));
+        } else { // a symmetric pair of sweeps, the first from zero
             smooth(l, true, true);
             smooth(l, false, false);
         }
         return;
     }
-    std::fill(L.x.begin(), L.x.end(), 0.0);
+    // x = 0 on entry: the first sweep starts from zero and writes every row without reading
+    // its old value, so no fill is needed (only without sweeps).
+    if (mSettings.sweeps < 1) std::fill(L.xp, L.xp + n3, 0.0);
     // t = r − A x. After one forward Gauss–Seidel sweep from zero, rows up to i already
     // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j, which that sweep accumulates itself.
     const BsrMatrix& a = L.a;
     const bool fused = mSettings.gaussSeidel && mSettings.sweeps == 1;
-    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, true, s == 0, fused);
+    bool pull = false; // t_i = −Σ_{j>i} A_ij x_j still to be pulled, row by row
+    for (int s = 0; s < mSettings.sweeps; ++s) pull = smooth(l, true, s == 0, fused);
     if (!fused) {
-        a.multiply(L.x.data(), L.t.data());
-        for (size_t k = 0; k < n3; ++k) L.t[k] = L.r[k] - L.t[k];
+        a.multiply(L.xp, L.t.data());
+        for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
     }
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i.
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
     Level& C = mLevels[l + 1];
+    const BsrPattern p = a.pattern();
     const bool filtered = l == 0 && !mKind.empty();
-    parallelChunks(static_cast<size_t>(C.a.n), 256, [&](size_t I0, size_t I1) {
+    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
         for (size_t I = I0; I < I1; ++I) {
             Vec3 s = Vec3::Zero();
             for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
                 const int i = L.members[m];
+                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i]) t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                if (filtered && mKind[i])
+                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
@@ -496,7 +497,7 @@ void BlockMultigrid::cycle(int l) {
             const int I = L.agg[i];
             Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
             if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
-            for (int q = 0; q < 3; ++q) L.x[3 * i + q] += alpha * e[q];
+            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
         }
     });
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
@@ -519,28 +520,14 @@ void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const 
 }
 
 double BlockMultigrid::apply(const double* r, double* z) {
+    // Level 0 reads r and writes x = z in place: no copies in or out.
     Level& L = mLevels[0];
-    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
-    std::copy(r, r + n3, L.r.begin());
+    L.rp = r;
+    L.xp = z;
     cycle(0);
-    // z = x and the chunk sums of rᵀz in one pass.
-    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
-    mPartial.assign(chunks, 0.0);
-    const double* x = L.x.data();
-    parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
-        for (size_t ch = c0; ch < c1; ++ch) {
-            const size_t e = std::min(n3, (ch + 1) * kReduceChunk);
-            double s = 0.0;
-            for (size_t k = ch * kReduceChunk; k < e; ++k) {
-                z[k] = x[k];
-                s += r[k] * x[k];
-            }
-            mPartial[ch] = s;
-        }
-    });
-    double s = 0.0;
-    for (double p : mPartial) s += p;
-    return s;
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    return deterministicDot(r, z, 3 * static_cast<size_t>(L.a.n));
 }
 
 } // namespace gale::solver

@@ -97,8 +97,8 @@ public:
     // natural index of each row).
     const BsrMatrix& matrix(int level) const { return mLevels[level].a; }
     const ColouredBlocks& colouring(int level) const { return mLevels[level].colouring; }
-    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero); returns rᵀz
-    // summed as deterministicDot does (fused with the copy-out).
+    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero, written into z
+    // directly; z must not overlap r); returns rᵀz (deterministicDot).
     double apply(const double* r, double* z);
     // y = Â x with the level-0 copy.
     void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
@@ -124,13 +124,16 @@ private:
         ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
         std::vector<int> visit;        // row of each natural index (the aggregation's order)
         std::vector<double> r, x, t;   // 3n work vectors
+        const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
+        double* xp = nullptr;
     };
 
     void buildHierarchy(const BlockMatrix& A);
     void aggregate(Level& fine, Level& coarse);
     void coarsen(int l);
-    // residual: (forward from zero only) also leave t = r − A x in L.t.
-    void smooth(int l, bool forward, bool fromZero, bool residual = false);
+    // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
+    // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
+    bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
 
     Settings mSettings = defaults();

@@ -103,30 +103,34 @@ TEST_CASE("multigrid: PCG agrees with LDLT on a filtered sheet with pins and con
 }
 
 TEST_CASE("multigrid: the V-cycle is symmetric and positive definite", "[multigrid]") {
-    for (bool constraints : {false, true}) {
-        Sheet s = makeSheet(32, constraints);
-        BlockMultigrid mg;
-        REQUIRE(mg.refresh(s.A, s.c, s.constrained));
-        REQUIRE(mg.levelCount() >= 2);
-        const int n3 = 3 * s.A.size();
-        std::mt19937 rng(11);
-        std::uniform_real_distribution<double> u(-1.0, 1.0);
-        for (int trial = 0; trial < 4; ++trial) {
-            VecX x(n3), y(n3), bx(n3), by(n3);
-            for (int q = 0; q < n3; ++q) x[q] = u(rng), y[q] = u(rng);
-            mg.apply(x.data(), bx.data());
-            mg.apply(y.data(), by.data());
-            const double xBy = x.dot(by), yBx = y.dot(bx);
-            CHECK(std::abs(xBy - yBx) <= 1e-10 * (std::abs(xBy) + bx.norm() * y.norm()));
-            CHECK(x.dot(bx) > 0.0);
-            CHECK(y.dot(by) > 0.0);
+    for (bool multicolour : {true, false})
+        for (bool constraints : {false, true}) {
+            INFO((multicolour ? "multicolour" : "lexicographic")
+                 << (constraints ? ", constrained" : ""));
+            Sheet s = makeSheet(32, constraints);
+            BlockMultigrid mg;
+            mg.settings().multicolour = multicolour;
+            REQUIRE(mg.refresh(s.A, s.c, s.constrained));
+            REQUIRE(mg.levelCount() >= 2);
+            const int n3 = 3 * s.A.size();
+            std::mt19937 rng(11);
+            std::uniform_real_distribution<double> u(-1.0, 1.0);
+            for (int trial = 0; trial < 4; ++trial) {
+                VecX x(n3), y(n3), bx(n3), by(n3);
+                for (int q = 0; q < n3; ++q) x[q] = u(rng), y[q] = u(rng);
+                mg.apply(x.data(), bx.data());
+                mg.apply(y.data(), by.data());
+                const double xBy = x.dot(by), yBx = y.dot(bx);
+                CHECK(std::abs(xBy - yBx) <= 1e-10 * (std::abs(xBy) + bx.norm() * y.norm()));
+                CHECK(x.dot(bx) > 0.0);
+                CHECK(y.dot(by) > 0.0);
+            }
+            // Positive on a smooth vector too (the coarse levels' range), not only on noise.
+            VecX smooth(n3), bs(n3);
+            for (int q = 0; q < n3; ++q) smooth[q] = 1.0 + 0.1 * (q % 3);
+            mg.apply(smooth.data(), bs.data());
+            CHECK(smooth.dot(bs) > 0.0);
         }
-        // Positive on a smooth vector too (the coarse levels' range), not only on noise.
-        VecX smooth(n3), bs(n3);
-        for (int q = 0; q < n3; ++q) smooth[q] = 1.0 + 0.1 * (q % 3);
-        mg.apply(smooth.data(), bs.data());
-        CHECK(smooth.dot(bs) > 0.0);
-    }
 }
 
 TEST_CASE("multigrid: one level is an exact solve", "[multigrid]") {
