@@ -15,6 +15,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -397,12 +398,21 @@ int runSim(const SimOptions& o) {
         run += "\n]}\n";
         return std::make_pair(writeBytes((fs::path(o.output) / "run.json").string(), run), run);
     };
+    // run.json holds every frame so far, so rewriting it after each frame costs O(frames²)
+    // bytes over a run: while running it is rewritten at most once a second (and after the
+    // first frame); --resume reads the per-frame .state files, never run.json.
+    auto lastRunWrite = std::chrono::steady_clock::now();
+    bool runWritten = false;
     auto saveFrame = [&](const solver::FrameStats& fsStats) -> int {
         if (int rc = writeFrame(scene, world, o.output, fsStats.frame)) return rc;
         const std::string js = frameJson(fsStats);
         if (int rc = writeBytes(stateFile(o.output, fsStats.frame, "bin"), world.saveState())) return rc;
         if (int rc = writeBytes(stateFile(o.output, fsStats.frame, "json"), js)) return rc;
         frames.push_back(js);
+        const auto now = std::chrono::steady_clock::now();
+        if (runWritten && now - lastRunWrite < std::chrono::seconds(1)) return kExitOk;
+        runWritten = true;
+        lastRunWrite = now;
         return writeRun("running").first;
     };
 

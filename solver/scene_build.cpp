@@ -7,6 +7,7 @@
 #include "lang/diagnostics.h"
 #include "runtime/program.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -270,20 +271,36 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
     return errors.size() == before;
 }
 
+// std::to_chars with a precision prints as printf's %.9g does (C++17 [charconv.to.chars]),
+// the same bytes at about a tenth of snprintf's cost (it was 13% of a light cloth's run).
 std::string bodyObjText(const Body& body) {
     std::string out;
     out.reserve(body.vertexCount() * 40);
     out += "# gale " + std::string(body.kind()) + " '" + body.name() + "'\n";
-    char buf[96];
+    char buf[128];
+    auto put = [&](char* p, double v) { return std::to_chars(p, buf + sizeof buf, v, std::chars_format::general, 9).ptr; };
+    auto putInt = [&](char* p, long v) { return std::to_chars(p, buf + sizeof buf, v).ptr; };
     const VecX& x = body.positions();
     for (size_t i = 0; i < body.vertexCount(); ++i) {
-        std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-        out += buf;
+        char* p = buf;
+        *p++ = 'v';
+        for (int k = 0; k < 3; ++k) {
+            *p++ = ' ';
+            p = put(p, x[3 * i + k]);
+        }
+        *p++ = '\n';
+        out.append(buf, p);
     }
     if (const Cloth* c = dynamic_cast<const Cloth*>(&body)) {
         for (const auto& t : c->mesh().triangles) {
-            std::snprintf(buf, sizeof buf, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
-            out += buf;
+            char* p = buf;
+            *p++ = 'f';
+            for (int k = 0; k < 3; ++k) {
+                *p++ = ' ';
+                p = putInt(p, t[k] + 1L);
+            }
+            *p++ = '\n';
+            out.append(buf, p);
         }
     } else if (const Hair* h = dynamic_cast<const Hair*>(&body)) {
         const Strands& s = h->strands();

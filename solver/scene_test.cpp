@@ -5,7 +5,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <iterator>
+#include <random>
 #include <fstream>
 #include <unistd.h>
 
@@ -127,6 +131,26 @@ TEST_CASE("scene: the solver's sections with their values", "[scene]") {
     const std::string obj = bodyObjText(*bodies[1]);
     CHECK(obj.find("\nl 1 2 3 4 5 6\n") != std::string::npos);
     CHECK(bodyPointSet(*bodies[0]).faces.size() == cloth.mesh().triangles.size());
+    // Vertex lines print exactly as printf's "v %.9g %.9g %.9g" (the bytes older runs wrote):
+    // signs, zeros, subnormals, exponents, huge values and rounding at the 9th digit.
+    Body& hair = *bodies[1];
+    const double special[] = {0.0, -0.0, 1.0, -1.5, 1e-300, 4.9e-324, 1.23456789012e-7, 123456789.5,
+                              -9.87654321e+22, 0.1, 2.0 / 3.0, 1e9, 999999999.5, 1.797e308};
+    VecX x = hair.positions();
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> mant(-10.0, 10.0);
+    std::uniform_int_distribution<int> expo(-30, 30);
+    for (long i = 0; i < x.size(); ++i)
+        x[i] = i < static_cast<long>(std::size(special)) ? special[i] : mant(rng) * std::pow(10.0, expo(rng));
+    hair.setPositions(x);
+    const std::string text = bodyObjText(hair);
+    std::string expected;
+    char buf[128];
+    for (size_t i = 0; i < hair.vertexCount(); ++i) {
+        std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        expected += buf;
+    }
+    CHECK(text.compare(text.find('\n') + 1, expected.size(), expected) == 0);
 }
 
 TEST_CASE("scene: --set overrides the solver's keys by dotted path", "[scene]") {
