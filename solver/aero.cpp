@@ -19,6 +19,9 @@ namespace gale::solver {
 
 namespace {
 
+// The skew part is kept where |c_w| > kSkewGate (C_D + C_L) (see aeroTriangle).
+constexpr double kSkewGate = 0.5;
+
 // n oriented two-sided against v, and the area, from the area-weighted normal.
 bool orientedNormal(const Vec3& vRel, const Vec3& areaNormal, Vec3& n, double& area) {
     area = areaNormal.norm();
@@ -161,7 +164,7 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
         // Kept only where it is comparable to the symmetric damping, |c_w| > ½(C_D + C_L) (the
         // default C_L = 0.3, C_D = 1 gives 0.1 against 0.65: left out, the solve stays symmetric).
         const double cw = model == AeroModel::Frozen ? cd - 3.0 * cl : cd - 3.0 * cl * (s / r);
-        if (std::abs(cw) > 0.5 * (cd + cl)) out.skewAxis = 0.5 * k * cw * n.cross(vRel);
+        if (std::abs(cw) > kSkewGate * (cd + cl)) out.skewAxis = 0.5 * k * cw * n.cross(vRel);
         if (model == AeroModel::Frozen) {
             const double iso = k * (cd - cl) * s;
             out.damping = projectPlane(2.0 * k * cd * s, 0.5 * k * (cd + cl) * q, iso, iso, n, e);

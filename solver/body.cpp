@@ -16,10 +16,10 @@
 namespace gale::solver {
 
 namespace {
-// Defect correction of the skew aerodynamic coupling (solveLinear): at most this many extra
-// solves, until the largest change of Δv is below this fraction of Δv's largest entry.
-constexpr int kMaxSkewCorrections = 12;
-constexpr double kSkewTolerance = 1e-3;
+// Flexible GMRES for the skew aerodynamic coupling (solveLinear): Krylov vectors per cycle and
+// cycles at most (each vector costs one preconditioning solve).
+constexpr int kGmresRestart = 20;
+constexpr int kGmresRestarts = 4;
 // A vertex this close to a collider's offset surface (m) counts as touching it: rounding
 // after a projection must not switch the contact off.
 constexpr double kContactSlop = 1e-7;
@@ -248,37 +248,112 @@ double Body::aeroQuadratic(const VecX& x) const {
 }
 
 // (H + B) Δv = b with H the assembled SPD matrix and B the skew part of the aerodynamic
-// Jacobian (mAero), by defect correction: H Δv_{j+1} = b − B Δv_j, each solve filtered and
-// warm-started. Converges when the spectral radius of H⁻¹B is below one (B is skew, H ≥ M).
+// Jacobian (mAero), under the constraint filter: with Δv = y + z (z prescribed, S y = y),
+//   S (H + B) S y = S (b − (H + B) z).
+// H + B is positive real (its symmetric part H is SPD), so GMRES converges; it is right-
+// preconditioned by the symmetric filtered solve itself (multigrid PCG or LDLᵀ on H, to a loose
+// tolerance: flexible GMRES, Saad 1993, since a PCG solve is not a fixed linear operator).
+// I + H⁻¹B has its eigenvalues on the line 1 + iμ, so few iterations suffice while ‖H⁻¹B‖ is
+// moderate. Started from the symmetric solution; if it does not reach the tolerance the step
+// keeps the symmetric solve (the skew part explicit, as it was before) and counts a fallback.
 SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
-    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver,
-                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
+    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver, mOptions.cgTolerance,
+                                   mOptions.cgMaxIterations);
     if (!mSkewed || !ls.converged || ls.failed) return ls;
-    const VecX dvSym = dv; // the symmetric solve: kept when the correction does not contract
-    VecX bd, prev;
-    double lastChange = 0.0;
-    for (int j = 0; j < kMaxSkewCorrections; ++j) {
-        skewProduct(dv, bd);
-        bd = b - bd;
-        prev = dv;
-        const SolveStatus s2 = mSolver.solve(mA, mConstraints, bd, dv, mOptions.linearSolver,
-                                             mOptions.cgTolerance, mOptions.cgMaxIterations);
-        ls.iterations += s2.iterations;
-        ls.residual = std::max(ls.residual, s2.residual);
-        const double change = (dv - prev).lpNorm<Eigen::Infinity>(),
-                     size = dv.lpNorm<Eigen::Infinity>();
-        // Contraction ratio ‖H⁻¹B‖ estimated from successive changes: at 0.9 and above (strong
-        // skew against little mass and damping, e.g. a cloth stretched far beyond its rest
-        // area) the correction is dropped and the step keeps the symmetric solve.
-        const bool diverging = !s2.converged || s2.failed || !std::isfinite(change) ||
-                               (j == 0 ? change > size : change > 0.9 * lastChange);
-        if (diverging) {
-            dv = dvSym;
-            ++ls.skewFallbacks;
+    const long n3 = b.size();
+    const auto dot = [&](const VecX& u, const VecX& w) {
+        return deterministicDot(u.data(), w.data(), static_cast<size_t>(n3));
+    };
+    VecX tmp(n3);
+    const auto op = [&](const VecX& y, VecX& out) { // out = S (H + B) y
+        out.resize(n3);
+        mA.multiply(y.data(), out.data());
+        skewProduct(y, tmp);
+        out += tmp;
+        mConstraints.apply(out.data());
+    };
+    mZeroZ = mConstraints;
+    std::fill(mZeroZ.z.begin(), mZeroZ.z.end(), 0.0);
+    const VecX z = Eigen::Map<const VecX>(mConstraints.z.data(), n3);
+    VecX rhs;
+    op(z, rhs);
+    VecX sb = b;
+    mConstraints.apply(sb.data());
+    rhs = sb - rhs;
+    const double target = mOptions.cgTolerance * std::sqrt(dot(rhs, rhs));
+    VecX y = dv - z;
+    const double precTolerance = std::max(mOptions.cgTolerance, 1e-2);
+    std::vector<VecX> V(kGmresRestart + 1), Z(kGmresRestart);
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(kGmresRestart + 1, kGmresRestart);
+    Eigen::VectorXd cs(kGmresRestart), sn(kGmresRestart), g(kGmresRestart + 1);
+    VecX r, w;
+    bool converged = false, failed = false;
+    for (int restart = 0; restart < kGmresRestarts && !converged && !failed; ++restart) {
+        op(y, r);
+        r = rhs - r;
+        const double beta = std::sqrt(dot(r, r));
+        if (!std::isfinite(beta)) {
+            failed = true;
             break;
         }
-        lastChange = change;
-        if (change <= kSkewTolerance * size) break;
+        if (beta <= target) {
+            converged = true;
+            break;
+        }
+        V[0] = r / beta;
+        g.setZero();
+        g[0] = beta;
+        int k = 0;
+        for (int j = 0; j < kGmresRestart; ++j) {
+            Z[j].setZero(n3);
+            const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver, precTolerance,
+                                                 mOptions.cgMaxIterations);
+            ls.iterations += ps.iterations;
+            if (ps.failed || !Z[j].allFinite()) {
+                failed = true;
+                break;
+            }
+            op(Z[j], w);
+            for (int i = 0; i <= j; ++i) { // modified Gram–Schmidt
+                H(i, j) = dot(w, V[i]);
+                w -= H(i, j) * V[i];
+            }
+            H(j + 1, j) = std::sqrt(dot(w, w));
+            for (int i = 0; i < j; ++i) { // the earlier Givens rotations on column j
+                const double t = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
+                H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
+                H(i, j) = t;
+            }
+            const double den = std::hypot(H(j, j), H(j + 1, j));
+            cs[j] = den > 0.0 ? H(j, j) / den : 1.0;
+            sn[j] = den > 0.0 ? H(j + 1, j) / den : 0.0;
+            const double hNext = H(j + 1, j);
+            H(j, j) = den;
+            H(j + 1, j) = 0.0;
+            g[j + 1] = -sn[j] * g[j];
+            g[j] = cs[j] * g[j];
+            k = j + 1;
+            if (std::abs(g[j + 1]) <= target) {
+                converged = true;
+                break;
+            }
+            if (!(hNext > 0.0)) break; // the Krylov space is invariant: the solution is in it
+            V[j + 1] = w / hNext;
+        }
+        if (failed || k == 0) break;
+        // y += Z c with R c = g (R the leading k × k triangle).
+        const Eigen::VectorXd c =
+            H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+        for (int i = 0; i < k; ++i) y += c[i] * Z[i];
+        if (!converged) { // recheck the true residual (an invariant space, or the next restart)
+            op(y, r);
+            converged = std::sqrt(dot(rhs - r, rhs - r)) <= target;
+        }
+    }
+    if (converged && y.allFinite()) {
+        dv = y + z;
+    } else {
+        ++ls.skewFallbacks; // dv keeps the symmetric solve
     }
     return ls;
 }

@@ -218,6 +218,7 @@ private:
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
+    Constraints mZeroZ;              // mConstraints with z = 0 (solveLinear's preconditioner)
     std::vector<Mat3> mDiagInv;      // Newton's residual weights (body.cpp, newton())
     double mHGuess = 0.0;
 };
