@@ -516,6 +516,56 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
     st.newtonResidual = rInf;
 }
 
+int Body::recover(const Snapshot& start, double h) {
+    const size_t n = vertexCount();
+    const VecX& x0 = start.x;
+    const VecX& v0 = start.v;
+    if (!mV.allFinite() || !mX.allFinite()) {
+        mV = v0;
+        mX = x0 + h * v0;
+    }
+    if (!std::isfinite(mRecoverySpeed)) mRecoverySpeed = mLimits.velocityJump;
+    // 1. Speeds capped at the world's speed scale, velocity_jump + 2 (wind + pins) (never the
+    // cloth's own, which may be what ran away); pins keep their motion.
+    std::vector<uint8_t> fixed(n, 0);
+    for (int i : mPinned) fixed[i] = 1;
+    for (size_t i = 0; i < n; ++i) {
+        if (mHeld[i]) fixed[i] = 1;
+        if (fixed[i]) continue;
+        Eigen::Map<Vec3> v(mV.data() + 3 * i);
+        const double speed = v.norm();
+        if (!(speed <= mRecoverySpeed)) v = std::isfinite(speed) ? Vec3((mRecoverySpeed / speed) * v) : Vec3::Zero();
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (!fixed[i]) mX.segment<3>(3 * i) = x0.segment<3>(3 * i) + h * mV.segment<3>(3 * i);
+    // 2. Strain limiting (Provot 1995): each edge longer than s·L₀ shortened to it, the change
+    // shared by inverse mass (fixed vertices do not move), Gauss–Seidel over the edges in order.
+    int shortened = 0;
+    for (int sweep = 0; sweep < 100; ++sweep) {
+        int changed = 0;
+        for (size_t e = 0; e < mEdges.size(); ++e) {
+            const int a = mEdges[e][0], b = mEdges[e][1];
+            const double wa = fixed[a] ? 0.0 : 1.0 / mMass[a], wb = fixed[b] ? 0.0 : 1.0 / mMass[b];
+            if (wa + wb == 0.0) continue;
+            Eigen::Map<Vec3> xa(mX.data() + 3 * a), xb(mX.data() + 3 * b);
+            const Vec3 d = xb - xa;
+            const double len = d.norm(), cap = mRecoveryStretch * mEdgeRest[e];
+            if (!(len > cap * (1.0 + 1e-9)) || !(len > 0.0)) continue;
+            const Vec3 corr = ((len - cap) / len) * d;
+            xa += (wa / (wa + wb)) * corr;
+            xb -= (wb / (wa + wb)) * corr;
+            ++changed;
+        }
+        shortened += changed;
+        if (changed == 0) break;
+    }
+    // 3. Velocities from the corrected positions, x₁ = x₀ + h v₁.
+    for (size_t i = 0; i < n; ++i)
+        if (!fixed[i]) mV.segment<3>(3 * i) = (mX.segment<3>(3 * i) - x0.segment<3>(3 * i)) / h;
+    mDvGuess = mV - v0;
+    return shortened;
+}
+
 SubstepStatus Body::substep(const Environment& env, double t, double h) {
     SubstepStatus st;
     const size_t n = vertexCount();
@@ -636,6 +686,8 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         }
     st.maxSpeed = maxSpeed;
     st.maxStretch = finite && !mEdges.empty() ? maxEdgeStretch() : 0.0;
+    mRecoverySpeed = mLimits.velocityJump + 2.0 * (maxWind + pinSpeed); // the world's speed scale
+    mRecoveryStretch = std::max(1.1, std::min(stretchBefore, mLimits.overStretch));
     char buf[200];
     if (!finite || ls.failed) {
         st.trouble = Trouble::NonFinite;
@@ -652,8 +704,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
                       st.maxStretch, mLimits.overStretch);
         st.reason = buf;
     } else {
-        const double limit =
-            mLimits.velocityJump + 2.0 * (maxWind + maxSpeed0 + pinSpeed + env.gravity.norm() * h);
+        const double limit = mRecoverySpeed;
         if (maxJump > limit) {
             st.trouble = Trouble::VelocityJump;
             std::snprintf(buf, sizeof buf, "a vertex changed speed by %.3g m/s in one substep "

@@ -162,6 +162,13 @@ public:
     Snapshot snapshot() const { return {mX, mV, mDvGuess, mHGuess}; }
     void restore(const Snapshot& s);
 
+    // The last line of defence at the smallest substep (World): from the state a troubled
+    // substep left, speeds capped at the world's speed scale, then strain limiting (no edge
+    // longer than max(1.1, the stretch at the substep's start, capped at over_stretch) × its
+    // rest length) and velocities consistent with the positions. Always finite. Returns the
+    // number of edge corrections.
+    int recover(const Snapshot& start, double h);
+
     double kineticEnergy() const;
     double potentialEnergy(const Vec3& gravity) const; // −Σ m g·x (J)
     double elasticEnergy(double t);                    // J, at the current positions
@@ -218,6 +225,7 @@ private:
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
+    double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
     Constraints mZeroZ;              // mConstraints with z = 0 (solveLinear's preconditioner)
     std::vector<Mat3> mDiagInv;      // Newton's residual weights (body.cpp, newton())
     double mHGuess = 0.0;

@@ -96,21 +96,22 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
                 stats.events.push_back(buf);
                 continue;
             }
-            if (st.trouble == Trouble::NonFinite) {
+            // At the smallest substep: recover (speeds capped, strain limited) rather
+            // than give up; the state stays finite and bounded.
+            const int fixes = body.recover(snap, h);
+            ++stats.recovered;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s) at the smallest substep %.6g s; recovered by strain "
+                          "limiting (%d edge correction(s)) and a speed cap",
+                          t, troubleName(st.trouble), st.reason.c_str(), h, fixes);
+            stats.events.push_back(buf);
+            if (!body.positions().allFinite() || !body.velocities().allFinite()) {
                 body.restore(snap);
                 stats.failed = true;
-                std::snprintf(buf, sizeof buf,
-                              "t=%.6g s: %s (%s) at the smallest substep %.6g s; run failed", t,
-                              troubleName(st.trouble), st.reason.c_str(), h);
-                stats.events.push_back(buf);
+                stats.events.push_back("run failed: the recovered state is not finite");
                 break;
             }
-            std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s) at the smallest substep %.6g s; accepted",
-                          t, troubleName(st.trouble), st.reason.c_str(), h);
-            stats.events.push_back(buf);
         }
-        stats.maxNewtonResidual = std::max(stats.maxNewtonResidual, st.newtonResidual);
-        if (st.newtonResidual > body.options().newtonTolerance) ++stats.newtonStalled;
         tick += ticksPerBase >> level;
         stats.contacts = st.contacts;
         ++stats.substeps;

@@ -27,6 +27,7 @@ struct BodyFrameStats {
     std::string name;
     int substeps = 0;        // accepted substeps
     int rejected = 0;        // substeps undone and retried at half the step
+    int recovered = 0;       // substeps at the smallest size recovered by Body::recover
     int deepestHalving = 0;  // 0: every substep at the base size
     long iterations = 0;     // linear-solver iterations, summed over substeps
     int maxIterations = 0;   // the most in one substep

@@ -1,15 +1,22 @@
-# Numerical faults under load: 50 randomised hard scenes (hard_scenes.awk, a fixed seed: wind
-# 0-60 m/s from windicator keys, gusts, presets and expressions; cloth of 0.001-1 kg/m^2 and
-# hair; keyframed pins, parameters and colliders) simulated two at a time. Every run exits 0
-# (recovered) or 4 (reported on stderr and in run.json), never a signal or another code, and no
-# frame written holds a NaN or an infinity. GALE_HARD_SEED=N runs another set.
+# Numerical faults under load: 3 × 50 randomised hard scenes (hard_scenes.awk, three fixed seeds:
+# wind 0-60 m/s from windicator keys, gusts, presets and expressions; cloth of 0.001-1 kg/m^2 and
+# hair; keyframed pins, parameters and colliders) simulated two at a time. Every run exits 0 —
+# trouble is recovered (halved substeps, at the smallest one strain limiting) and reported in
+# run.json, never a give-up (exit 4), a signal or another code — and no frame written holds a
+# NaN or an infinity. GALE_HARD_SEED=N runs one other set.
 source "$(dirname "$0")/lib.bash" "$@"
 
-SEED=${GALE_HARD_SEED:-20261122}
-COUNT=50
+SEEDS=${GALE_HARD_SEED:-20261122 7 8}
+COUNT=0
 mkdir scenes out
-awk -v seed="$SEED" -v count=$COUNT -v out=scenes -f "$SRC/tests/cli/hard_scenes.awk" ||
-    { fail "the scene generator"; finish; }
+for SEED in $SEEDS; do
+    mkdir "scenes.$SEED"
+    awk -v seed="$SEED" -v count=50 -v out="scenes.$SEED" -f "$SRC/tests/cli/hard_scenes.awk" ||
+        { fail "the scene generator"; finish; }
+    for f in "scenes.$SEED"/*.toml; do mv "$f" "scenes/s${SEED}_${f##*/}"; done
+    COUNT=$((COUNT + 50))
+done
+SEED="$SEEDS"
 expect_eq "$(ls scenes | wc -l)" "$COUNT" "generated scenes"
 
 # One run: exit code to NAME.rc, stderr to NAME.err (a signal shows as 128 + its number).
@@ -52,9 +59,7 @@ for scene in scenes/*.toml; do
             expect_match "$(head -c 20 "out/$name/run.json")" '"status": "ok"' "$name: run.json says ok" ;;
         4)
             reported=$((reported + 1))
-            expect_match "$err" "the run failed numerically .*frames up to -?[0-9]+ are written" "$name: exit 4 says why"
-            expect_match "$(head -c 20 "out/$name/run.json")" '"status": "failed"' "$name: run.json says failed"
-            expect_match "$(cat "out/$name/run.json")" 'run failed' "$name: run.json names the failing substep" ;;
+            fail "$name: exit 4, the run gave up (scene in scenes/$name.toml): $(tail -n 2 <<< "$err")" ;;
         *)
             fail "$name: exit $rc (a crash or an unexpected error; scene in scenes/$name.toml, seed $SEED): $(tail -n 3 <<< "$err")" ;;
     esac
@@ -66,7 +71,5 @@ for scene in scenes/*.toml; do
     done
     [ "$frames" -gt 0 ] || fail "$name: no frame written (exit $rc)"
 done
-# The scenes are meant to be hard, not broken: most of them must run to the end.
-[ "$ok" -ge $((COUNT / 2)) ] || fail "only $ok of $COUNT scenes ran to the end"
-echo "hard_scenes: seed $SEED: $ok recovered (exit 0), $reported reported (exit 4) in ${seconds}s on 2 workers" >&2
+echo "hard_scenes: seeds $SEED: $ok of $COUNT ran to the end (exit 0), $reported gave up (exit 4) in ${seconds}s on 2 workers" >&2
 finish
