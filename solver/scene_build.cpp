@@ -136,6 +136,30 @@ WorldSettings worldSettings(const SimScene& scene, int threads) {
     return ws;
 }
 
+// C_L > C_D (at the start or at any key of either): the aerodynamic force then pushes the cloth
+// across the flow against the air (the symmetric part of its Jacobian has the negative
+// eigenvalue ½ρA (C_D − C_L)(v·n), docs/solver.md), a drift the model itself amplifies. A
+// warning at the lift key's file:line:col; painted maps scale both and are not looked at.
+std::string liftAboveDragWarning(const SimScene& scene, const ClothSpec& spec, const std::string& what) {
+    std::vector<double> times = {0.0};
+    for (const fields::Param* p : {&spec.lift.value, &spec.drag.value})
+        if (p->isKeyed()) times.insert(times.end(), p->times().begin(), p->times().end());
+    for (double t : times) {
+        const double cl = spec.lift.value.scalarAt(t), cd = spec.drag.value.scalarAt(t);
+        if (!(cl > cd)) continue;
+        const int line = spec.lift.line > 0 ? spec.lift.line : spec.line;
+        const int col = spec.lift.line > 0 ? spec.lift.col : spec.col;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%s:%d:%d: %s: lift C_L = %.3g exceeds drag C_D = %.3g (at t = %.3g s)",
+                      scene.wind.path.c_str(), line, col, what.c_str(), cl, cd, t);
+        return std::string(buf) +
+               ": the lift then pushes the cloth sideways against the air, an unstable drift the "
+               "solver keeps bounded but does not damp (docs/solver.md); keep lift at or below drag "
+               "for calm cloth";
+    }
+    return {};
+}
+
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
                  std::vector<fields::SceneError>& errors, std::vector<std::string>& warnings,
                  const std::vector<std::string>& allowPaths) {
@@ -180,6 +204,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         if (cloth->degenerateTriangles())
             warnings.push_back(what + ": " + std::to_string(cloth->degenerateTriangles()) +
                                " degenerate triangle(s) take no stretch force");
+        if (std::string w = liftAboveDragWarning(scene, spec, what); !w.empty()) warnings.push_back(w);
         if (spec.hasPins) {
             PinSet pins;
             pins.translate = spec.pins.translate;

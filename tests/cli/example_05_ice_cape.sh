@@ -8,6 +8,9 @@ run "$GALE" check "$EX/scene.toml"
 expect_rc 0 "the scene checks clean"
 run "$GALE" sim "$EX/scene.toml" -o out
 expect_rc 0 "the full run"
+# C_L = 0.9 > C_D = 0.7: warned about at the lift key's position, once.
+expect_match "$ERR" "scene.toml:[0-9]+:[0-9]+: \[\[cloth\]\] 'cape': lift C_L = 0.9 exceeds drag C_D = 0.7" "the lift above the drag is warned about"
+expect_eq "$(grep -c 'exceeds drag' <<< "$ERR")" "1" "one warning"
 for f in 0001 0005 0036 0072; do [ -s "out/cape.$f.obj" ] || fail "out/cape.$f.obj written"; done
 expect_match "$(head -c 20 out/run.json)" '"status": "ok"' "run.json says ok"
 for f in 0005 0018 0036 0072; do
@@ -18,6 +21,9 @@ done
 far=$(awk '/^v / { d = ($3 - 1.6) ^ 2 + $4 ^ 2; if (d > 1.6 ^ 2) n++ } END { print n + 0 }' out/cape.0072.obj)
 expect_eq "$far" "0" "the cape stays within its length of the collar"
 if cmp -s out/cape.0001.obj out/cape.0005.obj; then fail "the wind moves the cape"; fi
+run "$GALE" sim "$EX/scene.toml" -o calm --frames 1:2 --set cloth.cape.lift=0.7
+expect_rc 0 "lift = drag"
+if grep -q 'exceeds drag' <<< "$ERR"; then fail "no warning when the lift does not exceed the drag"; fi
 run "$GALE" viz "$EX/scene.toml" --sim out --frames 5:5 -o 'preview.#.png' --size 480x400
 expect_rc 0 "a preview picture"
 [ -s preview.0005.png ] || fail "preview.0005.png written"
