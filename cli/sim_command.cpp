@@ -123,7 +123,7 @@ std::string frameJson(const solver::FrameStats& f) {
     for (size_t i = 0; i < f.bodies.size(); ++i) {
         const solver::BodyFrameStats& b = f.bodies[i];
         o << (i ? ", " : "") << "{\"name\": " << jsonString(b.name)
-          << ", \"substeps\": " << b.substeps << ", \"rejected_substeps\": " << b.rejected << ", \"recovered_substeps\": " << b.recovered
+          << ", \"substeps\": " << b.substeps << ", \"rejected_substeps\": " << b.rejected << ", \"recovered_substeps\": " << b.recovered << ", \"newton_retries\": " << b.newtonRetries
           << ", \"deepest_halving\": " << b.deepestHalving
           << ", \"solver_iterations\": " << b.iterations
           << ", \"max_iterations\": " << b.maxIterations

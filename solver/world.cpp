@@ -13,6 +13,11 @@
 
 namespace gale::solver {
 
+namespace {
+// Newton iterations of the retry of a substep in trouble (World::advanceBody).
+constexpr int kRetryNewtonIterations = 16;
+} // namespace
+
 struct World::Arena {
     tbb::task_arena arena;
     explicit Arena(int threads) : arena(threads) {}
@@ -70,7 +75,23 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
         const double t = t0 + hBase * (static_cast<double>(tick) / static_cast<double>(ticksPerBase));
         env.substepIndex = index;
         const Body::Snapshot snap = body.snapshot();
-        const SubstepStatus st = body.substep(env, t, h);
+        SubstepStatus st = body.substep(env, t, h);
+        // Over-stretch or a velocity jump from the linearised step: first the same substep again
+        // with Newton's line search (which cuts a step that over-stretches), then halving.
+        const int newton = body.options().newtonIterations;
+        if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
+            newton < kRetryNewtonIterations && !mSettings.noNewtonRetry) {
+            std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
+                          troubleName(st.trouble), st.reason.c_str(), kRetryNewtonIterations);
+            body.restore(snap);
+            body.options().newtonIterations = kRetryNewtonIterations;
+            const int firstIterations = st.iterations;
+            st = body.substep(env, t, h);
+            body.options().newtonIterations = newton;
+            st.iterations += firstIterations;
+            ++stats.newtonRetries;
+            stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None ? ": accepted" : ": still in trouble"));
+        }
         stats.iterations += st.iterations;
         stats.maxIterations = std::max(stats.maxIterations, st.iterations);
         stats.maxResidual = std::max(stats.maxResidual, st.residual);

@@ -20,6 +20,7 @@ struct WorldSettings {
     Vec3 gravity = Vec3(0.0, -9.81, 0.0);
     double airDensity = 1.225; // kg/m³
     int threads = 1;       // 0: all hardware threads; results do not depend on it
+    bool noNewtonRetry = false; // tests and benchmarks of the raw halving: no Newton retry
 };
 
 // Per body, per frame.
@@ -28,6 +29,7 @@ struct BodyFrameStats {
     int substeps = 0;        // accepted substeps
     int rejected = 0;        // substeps undone and retried at half the step
     int recovered = 0;       // substeps at the smallest size recovered by Body::recover
+    int newtonRetries = 0;   // substeps in trouble retried with Newton before halving
     int deepestHalving = 0;  // 0: every substep at the base size
     long iterations = 0;     // linear-solver iterations, summed over substeps
     int maxIterations = 0;   // the most in one substep
