@@ -385,6 +385,18 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
     return rInf;
 }
 
+bool Body::stretchFeasible(const VecX& x) const {
+    // The over-stretch detector's rule (substep()): trouble when an edge exceeds the limit and
+    // the largest stretch grew by more than 5 %. The line search takes no step into it.
+    const double cap = std::max(mLimits.overStretch, 1.05 * mStretchBefore);
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        if (!(mEdgeRest[e] > 0.0)) continue;
+        const double len = (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm();
+        if (!(len <= cap * mEdgeRest[e])) return false;
+    }
+    return true;
+}
+
 double Body::elasticAt(const VecX& x, double t, VecX& fEl) {
     fEl.setZero(x.size());
     mZero.setZero(x.size());
@@ -457,7 +469,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         const double eTrial = elasticAt(trialX, t1, fElTrial);
         phiTrial = phi(mDv, eTrial, dvBase);
         const bool ok = slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
-        if (ok && std::isfinite(phiTrial)) {
+        if (ok && std::isfinite(phiTrial) && stretchFeasible(trialX)) {
             energy = eTrial;
             mFel = fElTrial;
             break;
@@ -498,8 +510,8 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
             trialX = x0 + h * (v0 + mDv);
             const double eTrial = elasticAt(trialX, t1, fElTrial);
             phiTrial = phi(mDv, eTrial, dvBase);
-            if (std::isfinite(phiTrial) &&
-                phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0)) {
+            if (std::isfinite(phiTrial) && phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0) &&
+                stretchFeasible(trialX)) {
                 energy = eTrial;
                 mFel = fElTrial;
                 accepted = true;
@@ -571,6 +583,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     const size_t n = vertexCount();
     const VecX x0 = mX, v0 = mV;
     const double stretchBefore = mEdges.empty() ? 0.0 : maxEdgeStretch();
+    mStretchBefore = stretchBefore;
 
     // 1. Wind at the vertices, once per substep, as one batch.
     const bool aero = feelsWind();

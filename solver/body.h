@@ -205,6 +205,8 @@ private:
     double aeroQuadratic(const VecX& x) const;
     // The linear solve of the step with the assembled matrix and the skew couplings.
     SolveStatus solveLinear(const VecX& b, VecX& dv);
+    // Whether no edge at positions x is over-stretched by the trouble detector's rule.
+    bool stretchFeasible(const VecX& x) const;
     // Elastic energy (J) and conservative elastic forces f_E = −∇E (N) at positions x.
     double elasticAt(const VecX& x, double t, VecX& fEl);
     void newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
@@ -225,6 +227,7 @@ private:
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
+    double mStretchBefore = 0.0; // the largest edge stretch at the substep's start
     double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
     Constraints mZeroZ;              // mConstraints with z = 0 (solveLinear's preconditioner)
     std::vector<Mat3> mDiagInv;      // Newton's residual weights (body.cpp, newton())
