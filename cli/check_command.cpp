@@ -54,7 +54,7 @@ int runCheck(const CheckOptions& options) {
         printError("nothing to check: give expression files (FILE.se...) or -e EXPR");
         return kExitUsage;
     }
-    fields::PointSet points;
+    io::PointSet points;
     if (!options.points.empty()) {
         if (int rc = loadPoints(options.points, points)) return rc;
     }

@@ -265,8 +265,8 @@ bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::strin
         }
         return true;
     }
-    fields::PointSet ps;
-    if (fields::IoError e = fields::readPoints(path, ps)) {
+    io::PointSet ps;
+    if (io::IoError e = io::readPoints(path, ps)) {
         error = e.render();
         return false;
     }
@@ -302,7 +302,7 @@ int runVizFrames(const VizOptions& o) {
         printError(error);
         return kExitUsage;
     }
-    if (!imageFormatFromPath(o.output, format) || !fields::framePath(o.output, frames.front(), probe)) {
+    if (!imageFormatFromPath(o.output, format) || !io::framePath(o.output, frames.front(), probe)) {
         printError("-o '" + o.output + "': with --frames, name a .png or .svg with one run of # for the frame "
                    "number (preview.#.png)");
         return kExitUsage;
@@ -382,10 +382,10 @@ int runVizFrames(const VizOptions& o) {
         settings.arrowSpacing = o.arrowSpacing;
         settings.fieldRaster = !o.noField;
         std::string path;
-        fields::framePath(o.output, f, path);
-        if (fields::IoError e = renderSlice(path, layout, slice, overlays, settings)) {
+        io::framePath(o.output, f, path);
+        if (io::IoError e = renderSlice(path, layout, slice, overlays, settings)) {
             std::cerr << e.render() << '\n';
-            return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+            return e.kind == io::IoError::Io ? kExitIo : kExitInput;
         }
     }
     return kExitOk;
@@ -523,9 +523,9 @@ int runContactSheet(const VizOptions& o) {
         }
         sheet.rows.push_back(std::move(row));
     }
-    if (fields::IoError e = renderContactSheet(o.output, sheet)) {
+    if (io::IoError e = renderContactSheet(o.output, sheet)) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+        return e.kind == io::IoError::Io ? kExitIo : kExitInput;
     }
     return kExitOk;
 }

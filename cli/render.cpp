@@ -845,9 +845,9 @@ cairo_status_t writeToFile(void* closure, const unsigned char* data, unsigned in
     return CAIRO_STATUS_SUCCESS;
 }
 
-fields::IoError cairoError(const std::string& path, cairo_status_t status, int err) {
-    fields::IoError e;
-    e.kind = fields::IoError::Io;
+io::IoError cairoError(const std::string& path, cairo_status_t status, int err) {
+    io::IoError e;
+    e.kind = io::IoError::Io;
     e.file = path;
     e.message =
         "cannot write: " + std::string(err ? std::strerror(err) : cairo_status_to_string(status));
@@ -900,8 +900,8 @@ bool layoutSlice(int width, int height, double boundsW, double boundsH, bool tim
     return true;
 }
 
-fields::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
-                            const SliceOverlays& overlays, const RenderSettings& settings) {
+io::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
+                        const SliceOverlays& overlays, const RenderSettings& settings) {
     auto draw = [&](cairo_surface_t* surface) {
         cairo_t* cr = cairo_create(surface);
         Painter(cr, layout, slice, overlays, settings).paint();
@@ -915,14 +915,14 @@ fields::IoError renderSlice(const std::string& path, const SliceLayout& layout, 
         image.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height));
         const cairo_status_t status = draw(image.get());
         if (status != CAIRO_STATUS_SUCCESS) {
-            fields::IoError e;
-            e.kind = fields::IoError::Data;
+            io::IoError e;
+            e.kind = io::IoError::Data;
             e.file = path;
             e.message = std::string("cannot draw the picture: ") + cairo_status_to_string(status);
             return e;
         }
     }
-    return fields::writeFileAtomic(path, [&](const std::string& tmp) -> fields::IoError {
+    return io::writeFileAtomic(path, [&](const std::string& tmp) -> io::IoError {
         FileSink sink;
         errno = 0;
         sink.f = std::fopen(tmp.c_str(), "wb");
@@ -965,7 +965,7 @@ SliceLayout layoutThumbnail(int width, int height, double boundsW, double bounds
     return l;
 }
 
-fields::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet) {
+io::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet) {
     const int gap = 8, top = 64, head = 22;
     const int cols = static_cast<int>(sheet.columnHeadings.size());
     const int rows = static_cast<int>(sheet.rows.size());
@@ -1013,13 +1013,13 @@ fields::IoError renderContactSheet(const std::string& path, const ContactSheet& 
     const cairo_status_t status = cairo_status(cr);
     cairo_destroy(cr);
     if (status != CAIRO_STATUS_SUCCESS) {
-        fields::IoError e;
-        e.kind = fields::IoError::Data;
+        io::IoError e;
+        e.kind = io::IoError::Data;
         e.file = path;
         e.message = std::string("cannot draw the contact sheet: ") + cairo_status_to_string(status);
         return e;
     }
-    return fields::writeFileAtomic(path, [&](const std::string& tmp) -> fields::IoError {
+    return io::writeFileAtomic(path, [&](const std::string& tmp) -> io::IoError {
         FileSink sink;
         errno = 0;
         sink.f = std::fopen(tmp.c_str(), "wb");

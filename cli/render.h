@@ -3,7 +3,7 @@
 // windicator arrow, gust fronts and a gust timeline. Only render.cpp includes cairo.
 #pragma once
 
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <array>
 #include <string>
@@ -105,8 +105,8 @@ struct RenderSettings {
 };
 
 // Draws the picture and writes it to `path` through a temporary file and a rename.
-fields::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
-                            const SliceOverlays& overlays, const RenderSettings& settings);
+io::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
+                        const SliceOverlays& overlays, const RenderSettings& settings);
 
 // One thumbnail of a contact sheet: a picture laid out for the cell (layoutThumbnail).
 struct ContactCell {
@@ -128,6 +128,6 @@ struct ContactSheet {
     int labelW = 220;
     std::vector<std::vector<ContactCell>> rows;      // rows[r][c]
 };
-fields::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet);
+io::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet);
 
 } // namespace gale::cli

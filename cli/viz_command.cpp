@@ -254,10 +254,10 @@ int runViz(const VizOptions& o) {
                                               : FlowStyle::Arrows;
     settings.speedMax = o.speedMax;
     settings.arrowSpacing = o.arrowSpacing;
-    fields::IoError e = renderSlice(o.output, layout, slice, overlays, settings);
+    io::IoError e = renderSlice(o.output, layout, slice, overlays, settings);
     if (e) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+        return e.kind == io::IoError::Io ? kExitIo : kExitInput;
     }
     return kExitOk;
 }

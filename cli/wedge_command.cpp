@@ -5,7 +5,7 @@
 #include "cli/common.h"
 #include "cli/wedge.h"
 
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
 #include "solver/scene.h"
 
 #include <CLI/CLI.hpp>

@@ -3,7 +3,7 @@
 // the automatic narrow-band width.
 #include "fields/geometry.h"
 
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,9 +12,9 @@ namespace gale::fields {
 
 namespace {
 
-IoError meshError(const std::string& path, const std::string& message) {
-    IoError e;
-    e.kind = IoError::Data;
+io::IoError meshError(const std::string& path, const std::string& message) {
+    io::IoError e;
+    e.kind = io::IoError::Data;
     e.file = path;
     e.message = message;
     return e;
@@ -34,14 +34,14 @@ std::array<double, 6> TriangleMesh::bounds() const {
     return b;
 }
 
-IoError readTriangleMesh(const std::string& path, TriangleMesh& out) {
-    PointFormat format;
-    if (!formatFromPath(path, format) ||
-        (format != PointFormat::Obj && format != PointFormat::Ply &&
-         format != PointFormat::PlyAscii))
+io::IoError readTriangleMesh(const std::string& path, TriangleMesh& out) {
+    io::PointFormat format;
+    if (!io::formatFromPath(path, format) ||
+        (format != io::PointFormat::Obj && format != io::PointFormat::Ply &&
+         format != io::PointFormat::PlyAscii))
         return meshError(path, "a mesh must be an .obj or .ply file");
-    PointSet ps;
-    if (IoError e = readPoints(path, ps)) return e;
+    io::PointSet ps;
+    if (io::IoError e = io::readPoints(path, ps)) return e;
     const int axes[3] = {ps.find("x"), ps.find("y"), ps.find("z")};
     if (axes[0] < 0 || axes[1] < 0 || axes[2] < 0)
         return meshError(path, "the mesh has no x, y, z vertex positions");
@@ -130,16 +130,16 @@ TriangleMesh boxMesh(const std::array<double, 3>& lo, const std::array<double, 3
     return m;
 }
 
-IoError writeTriangleMeshObj(const std::string& path, const TriangleMesh& mesh) {
+io::IoError writeTriangleMeshObj(const std::string& path, const TriangleMesh& mesh) {
     std::string text;
     text.reserve(mesh.points.size() * 32 + mesh.triangles.size() * 24);
     for (const auto& p : mesh.points)
-        text += "v " + formatNumber(p[0]) + ' ' + formatNumber(p[1]) + ' ' + formatNumber(p[2]) +
-                '\n';
+        text += "v " + io::formatNumber(p[0]) + ' ' + io::formatNumber(p[1]) + ' ' +
+                io::formatNumber(p[2]) + '\n';
     for (const auto& t : mesh.triangles)
         text += "f " + std::to_string(t[0] + 1) + ' ' + std::to_string(t[1] + 1) + ' ' +
                 std::to_string(t[2] + 1) + '\n';
-    return writeBytesAtomic(path, text);
+    return io::writeBytesAtomic(path, text);
 }
 
 std::array<double, 3> closestPointOnTriangle(const std::array<double, 3>& p,

@@ -4,7 +4,7 @@
 // The OpenVDB code lives in vdb_geometry.cpp (SDF, closest triangle) and vdb_io.cpp (.vdb files).
 #pragma once
 
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <array>
 #include <cstdint>
@@ -26,7 +26,7 @@ struct TriangleMesh {
 // Reads an OBJ or PLY mesh (by extension) and fans every polygon into triangles. Errors: Io when
 // the file cannot be read; Data when it is malformed, has no faces, has a face with fewer than
 // three corners or an index out of range, or a non-finite vertex.
-IoError readTriangleMesh(const std::string& path, TriangleMesh& out);
+io::IoError readTriangleMesh(const std::string& path, TriangleMesh& out);
 
 // Closed meshes for tests, benchmarks and examples: a UV sphere (`rings` latitude bands,
 // `segments` longitude slices) and an axis-aligned box (12 triangles), both outward-facing.
@@ -35,7 +35,7 @@ TriangleMesh uvSphereMesh(const std::array<double, 3>& centre, double radius, in
 TriangleMesh boxMesh(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
 
 // Writes `v` and `f` lines (1-based indices) through a temporary file and a rename.
-IoError writeTriangleMeshObj(const std::string& path, const TriangleMesh& mesh);
+io::IoError writeTriangleMeshObj(const std::string& path, const TriangleMesh& mesh);
 
 // The point of triangle (a, b, c) closest to p, with its barycentric weights (wa + wb + wc = 1).
 std::array<double, 3> closestPointOnTriangle(const std::array<double, 3>& p,
@@ -69,8 +69,8 @@ public:
 
     // Errors (Data, naming `name`): an empty mesh, a voxel size that is not positive and
     // finite, a band too large for kMaxSdfVoxels, or an OpenVDB failure.
-    static IoError build(const TriangleMesh& mesh, const SdfOptions& options,
-                         std::shared_ptr<const SdfVolume>& out, const std::string& name = {});
+    static io::IoError build(const TriangleMesh& mesh, const SdfOptions& options,
+                             std::shared_ptr<const SdfVolume>& out, const std::string& name = {});
 
     // For n points xyz[3i..3i+2]: dist[i] (m) and the unit gradient grad[3i..] (central
     // differences of the distance one voxel apart; where those vanish — deep inside, or beyond
@@ -86,7 +86,7 @@ public:
 
     // Writes the level set as a .vdb file (one float grid named `gridName`, class level set) for
     // inspection in Houdini or Blender; atomic like every gale output.
-    IoError writeVdb(const std::string& path, const std::string& gridName = "surface") const;
+    io::IoError writeVdb(const std::string& path, const std::string& gridName = "surface") const;
 
     double voxel() const;
     double band() const; // metres
@@ -106,9 +106,9 @@ public:
     struct Impl;
     ~ClosestTriangleIndex();
 
-    static IoError build(const TriangleMesh& mesh, double voxel, double reach,
-                         std::shared_ptr<const ClosestTriangleIndex>& out,
-                         const std::string& name = {});
+    static io::IoError build(const TriangleMesh& mesh, double voxel, double reach,
+                             std::shared_ptr<const ClosestTriangleIndex>& out,
+                             const std::string& name = {});
 
     // For each point, the closest-triangle indices of the 8 voxel centres around it
     // (out[8i..8i+7]; -1 where a centre is beyond the reach).
@@ -137,8 +137,8 @@ public:
     // cannot be opened or is not a readable VDB file (truncated, corrupt); Data when the grid
     // is missing (the message lists the grids there are), holds non-vector values, or has a
     // non-linear (frustum) transform.
-    static IoError load(const std::string& path, const std::string& gridName,
-                        std::shared_ptr<const VelocityVolume>& out);
+    static io::IoError load(const std::string& path, const std::string& gridName,
+                            std::shared_ptr<const VelocityVolume>& out);
 
     // vel[3i..3i+2] at xyz[3i..3i+2].
     void sample(const double* xyz, size_t n, VolumeInterp interp, double* vel) const;
@@ -154,6 +154,6 @@ private:
 // Checks, from the file header and grid descriptors only (no voxel data), that `path` is a VDB
 // file holding a vector grid named `gridName` (empty: any vector grid); the same errors as
 // VelocityVolume::load.
-IoError checkVdbGrid(const std::string& path, const std::string& gridName);
+io::IoError checkVdbGrid(const std::string& path, const std::string& gridName);
 
 } // namespace gale::fields

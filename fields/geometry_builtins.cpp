@@ -99,7 +99,7 @@ void forFrameRuns(const KernelFrame<T>& f, int frameArg, F&& fn) {
     }
 }
 
-std::string loadMessage(const FileRef& ref, const FrameFile& file, const IoError& e) {
+std::string loadMessage(const FileRef& ref, const FrameFile& file, const io::IoError& e) {
     std::string what = "'" + ref.name + "'";
     if (ref.sequence) what += " (frame " + std::to_string(file.frame) + ")";
     return "cannot load " + what + ": " + (e.file.empty() ? file.path : e.file) + ": " + e.message;
@@ -122,7 +122,7 @@ struct SdfK {
         forFrameRuns(f, 3, [&](int i0, int count, double frame) {
             const FrameFile& file = nearestFrame(*ref, frame);
             std::shared_ptr<const SdfVolume> sdf;
-            if (IoError e = cachedSdf(file, voxel, sdf))
+            if (io::IoError e = cachedSdf(file, voxel, sdf))
                 return fail(f, ctx, i0, count, loadMessage(*ref, file, e));
             if (Gradient)
                 sdf->sample(xyz + 3 * i0, static_cast<size_t>(count), nullptr, out + 3 * i0);
@@ -153,7 +153,7 @@ struct ShadowK {
         forFrameRuns(f, 5, [&](int i0, int count, double frame) {
             const FrameFile& file = nearestFrame(*ref, frame);
             std::shared_ptr<const SdfVolume> sdf;
-            if (IoError e = cachedSdf(file, voxel, sdf))
+            if (io::IoError e = cachedSdf(file, voxel, sdf))
                 return fail(f, ctx, i0, count, loadMessage(*ref, file, e));
             sdf->shadow(xyz + 3 * i0, dir + 3 * i0, length + i0, static_cast<size_t>(count),
                         out + i0);
@@ -184,11 +184,11 @@ struct VdbK {
             double w = 0.0;
             bracketFrames(*ref, frame, a, b, w);
             std::shared_ptr<const VelocityVolume> volA, volB;
-            if (IoError e = cachedVelocity(ref->frames[a], grid, volA))
+            if (io::IoError e = cachedVelocity(ref->frames[a], grid, volA))
                 return fail(f, ctx, i0, count, loadMessage(*ref, ref->frames[a], e));
             volA->sample(xyz + 3 * i0, static_cast<size_t>(count), interp, va + 3 * i0);
             if (w > 0.0) {
-                if (IoError e = cachedVelocity(ref->frames[b], grid, volB))
+                if (io::IoError e = cachedVelocity(ref->frames[b], grid, volB))
                     return fail(f, ctx, i0, count, loadMessage(*ref, ref->frames[b], e));
                 volB->sample(xyz + 3 * i0, static_cast<size_t>(count), interp, vb + 3 * i0);
                 for (int i = 3 * i0; i < 3 * (i0 + count); ++i) va[i] += w * (vb[i] - va[i]);
@@ -210,8 +210,8 @@ struct FrameMotion {
     std::shared_ptr<const ClosestTriangleIndex> index;
 };
 
-IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxels,
-                    std::shared_ptr<const FrameMotion>& out) {
+io::IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxels,
+                        std::shared_ptr<const FrameMotion>& out) {
     const size_t lo = j > 0 ? j - 1 : j, hi = j + 1 < ref.frames.size() ? j + 1 : j;
     char voxelText[32];
     std::snprintf(voxelText, sizeof voxelText, "%.17g", voxel);
@@ -219,17 +219,17 @@ IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxels,
                             ref.frames[hi].key + "|" + voxelText + "|" + std::to_string(bandVoxels);
     return GeometryCache::global().get<FrameMotion>(
         key,
-        [&](std::shared_ptr<const FrameMotion>& v, size_t& bytes) -> IoError {
+        [&](std::shared_ptr<const FrameMotion>& v, size_t& bytes) -> io::IoError {
             auto m = std::make_shared<FrameMotion>();
             std::shared_ptr<const TriangleMesh> a, b;
-            if (IoError e = cachedMesh(ref.frames[j], m->mesh)) return e;
-            if (IoError e = cachedMesh(ref.frames[lo], a)) return e;
-            if (IoError e = cachedMesh(ref.frames[hi], b)) return e;
+            if (io::IoError e = cachedMesh(ref.frames[j], m->mesh)) return e;
+            if (io::IoError e = cachedMesh(ref.frames[lo], a)) return e;
+            if (io::IoError e = cachedMesh(ref.frames[hi], b)) return e;
             for (const auto* other : {a.get(), b.get()}) {
                 if (other->points.size() != m->mesh->points.size() ||
                     other->triangles != m->mesh->triangles) {
-                    IoError e;
-                    e.kind = IoError::Data;
+                    io::IoError e;
+                    e.kind = io::IoError::Data;
                     e.file = ref.frames[j].path;
                     e.message = "the frames of '" + ref.name +
                                 "' do not share one mesh (vertex count or faces differ between "
@@ -247,7 +247,7 @@ IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxels,
                         m->velocity[i][static_cast<size_t>(k)] = static_cast<float>(
                             (static_cast<double>(b->points[i][static_cast<size_t>(k)]) -
                              a->points[i][static_cast<size_t>(k)]) / span);
-            if (IoError e = cachedTriangleIndex(ref.frames[j], voxel, bandVoxels, m->index))
+            if (io::IoError e = cachedTriangleIndex(ref.frames[j], voxel, bandVoxels, m->index))
                 return e;
             bytes = m->velocity.size() * sizeof(m->velocity[0]);
             v = std::move(m);
@@ -295,9 +295,9 @@ struct MeshVelK {
             double w = 0.0;
             bracketFrames(*ref, frame, a, b, w);
             std::shared_ptr<const FrameMotion> ma, mb;
-            if (IoError e = frameMotion(*ref, a, voxel, band, ma))
+            if (io::IoError e = frameMotion(*ref, a, voxel, band, ma))
                 return fail(f, ctx, i0, count, loadMessage(*ref, ref->frames[a], e));
-            if (IoError e = frameMotion(*ref, b, voxel, band, mb))
+            if (io::IoError e = frameMotion(*ref, b, voxel, band, mb))
                 return fail(f, ctx, i0, count, loadMessage(*ref, ref->frames[b], e));
             if (ma->mesh->points.size() != mb->mesh->points.size() ||
                 ma->mesh->triangles != mb->mesh->triangles)
@@ -394,7 +394,7 @@ std::shared_ptr<const FileRef> resolveArg(lang::CallSite& site, const std::strin
 }
 
 void loadError(lang::CallSite& site, const FileRef& ref, const FrameFile& file,
-               const IoError& e) {
+               const io::IoError& e) {
     site.sink->error(site.argSpans[0], loadMessage(ref, file, e));
 }
 
@@ -407,14 +407,14 @@ bool validateMeshSdf(lang::CallSite& site, size_t voxelArg) {
     if (!ref) return false;
     const FrameFile& first = ref->frames.front();
     std::shared_ptr<const TriangleMesh> mesh;
-    if (IoError e = cachedMesh(first, mesh)) {
+    if (io::IoError e = cachedMesh(first, mesh)) {
         loadError(site, *ref, first, e);
         return false;
     }
     const std::vector<double>& voxel = site.constValues[voxelArg];
     if (!voxel.empty()) {
         std::shared_ptr<const SdfVolume> sdf;
-        if (IoError e = cachedSdf(first, voxel[0], sdf)) {
+        if (io::IoError e = cachedSdf(first, voxel[0], sdf)) {
             loadError(site, *ref, first, e);
             return false;
         }
@@ -440,13 +440,13 @@ bool validateVdb(lang::CallSite& site) {
     if (!ref) return false;
     // Every frame's header names the grid with a vector type; the first frame loads fully.
     for (const FrameFile& file : ref->frames) {
-        if (IoError e = checkVdbGrid(file.path, *grid)) {
+        if (io::IoError e = checkVdbGrid(file.path, *grid)) {
             loadError(site, *ref, file, e);
             return false;
         }
     }
     std::shared_ptr<const VelocityVolume> volume;
-    if (IoError e = cachedVelocity(ref->frames.front(), *grid, volume)) {
+    if (io::IoError e = cachedVelocity(ref->frames.front(), *grid, volume)) {
         loadError(site, *ref, ref->frames.front(), e);
         return false;
     }
@@ -467,7 +467,7 @@ bool validateMeshVel(lang::CallSite& site) {
         return false;
     }
     std::shared_ptr<const TriangleMesh> mesh;
-    if (IoError e = cachedMesh(ref->frames.front(), mesh)) {
+    if (io::IoError e = cachedMesh(ref->frames.front(), mesh)) {
         loadError(site, *ref, ref->frames.front(), e);
         return false;
     }

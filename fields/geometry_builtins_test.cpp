@@ -2,9 +2,9 @@
 // and closed forms, meshvel() gives a translating sphere's velocity with its falloff, scenes
 // resolve names against their folder, and every misuse is a diagnostic at the argument's
 // file:line:col naming the file (missing, outside the folder, not constant, varying settings).
-#include "fields/test_support.h"
 #include "fields/expression_field.h"
 #include "fields/geometry.h"
+#include "io/test_support.h"
 #include "lang/diagnostics.h"
 
 #include <catch2/catch.hpp>
@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 struct Compiled {
     std::shared_ptr<ExpressionField> field;

@@ -52,10 +52,10 @@ GeometryCache::Built GeometryCache::getErased(const std::string& key, const Buil
     try {
         built = build();
     } catch (const std::exception& ex) {
-        built.error.kind = IoError::Data;
+        built.error.kind = io::IoError::Data;
         built.error.message = ex.what();
     } catch (...) {
-        built.error.kind = IoError::Data;
+        built.error.kind = io::IoError::Data;
         built.error.message = "unknown failure";
     }
     promise.set_value(built);
@@ -143,12 +143,12 @@ std::string keyNumber(double v) {
 
 } // namespace
 
-IoError cachedMesh(const FrameFile& file, std::shared_ptr<const TriangleMesh>& out) {
+io::IoError cachedMesh(const FrameFile& file, std::shared_ptr<const TriangleMesh>& out) {
     return GeometryCache::global().get<TriangleMesh>(
         "mesh|" + file.key,
-        [&](std::shared_ptr<const TriangleMesh>& v, size_t& bytes) -> IoError {
+        [&](std::shared_ptr<const TriangleMesh>& v, size_t& bytes) -> io::IoError {
             auto mesh = std::make_shared<TriangleMesh>();
-            if (IoError e = readTriangleMesh(file.path, *mesh)) return e;
+            if (io::IoError e = readTriangleMesh(file.path, *mesh)) return e;
             bytes = mesh->points.size() * sizeof(mesh->points[0]) +
                     mesh->triangles.size() * sizeof(mesh->triangles[0]);
             v = std::move(mesh);
@@ -157,42 +157,42 @@ IoError cachedMesh(const FrameFile& file, std::shared_ptr<const TriangleMesh>& o
         out);
 }
 
-IoError cachedSdf(const FrameFile& file, double voxel, std::shared_ptr<const SdfVolume>& out) {
+io::IoError cachedSdf(const FrameFile& file, double voxel, std::shared_ptr<const SdfVolume>& out) {
     return GeometryCache::global().get<SdfVolume>(
         "sdf|" + file.key + "|" + keyNumber(voxel),
-        [&](std::shared_ptr<const SdfVolume>& v, size_t& bytes) -> IoError {
+        [&](std::shared_ptr<const SdfVolume>& v, size_t& bytes) -> io::IoError {
             std::shared_ptr<const TriangleMesh> mesh;
-            if (IoError e = cachedMesh(file, mesh)) return e;
+            if (io::IoError e = cachedMesh(file, mesh)) return e;
             SdfOptions options;
             options.voxel = voxel;
-            if (IoError e = SdfVolume::build(*mesh, options, v, file.path)) return e;
+            if (io::IoError e = SdfVolume::build(*mesh, options, v, file.path)) return e;
             bytes = v->memoryBytes();
             return {};
         },
         out);
 }
 
-IoError cachedVelocity(const FrameFile& file, const std::string& gridName,
-                       std::shared_ptr<const VelocityVolume>& out) {
+io::IoError cachedVelocity(const FrameFile& file, const std::string& gridName,
+                           std::shared_ptr<const VelocityVolume>& out) {
     return GeometryCache::global().get<VelocityVolume>(
         "vdb|" + file.key + "|" + gridName,
-        [&](std::shared_ptr<const VelocityVolume>& v, size_t& bytes) -> IoError {
-            if (IoError e = VelocityVolume::load(file.path, gridName, v)) return e;
+        [&](std::shared_ptr<const VelocityVolume>& v, size_t& bytes) -> io::IoError {
+            if (io::IoError e = VelocityVolume::load(file.path, gridName, v)) return e;
             bytes = v->memoryBytes();
             return {};
         },
         out);
 }
 
-IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVoxels,
-                            std::shared_ptr<const ClosestTriangleIndex>& out) {
+io::IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVoxels,
+                                std::shared_ptr<const ClosestTriangleIndex>& out) {
     return GeometryCache::global().get<ClosestTriangleIndex>(
         "tri|" + file.key + "|" + keyNumber(voxel) + "|" + std::to_string(bandVoxels),
-        [&](std::shared_ptr<const ClosestTriangleIndex>& v, size_t& bytes) -> IoError {
+        [&](std::shared_ptr<const ClosestTriangleIndex>& v, size_t& bytes) -> io::IoError {
             std::shared_ptr<const TriangleMesh> mesh;
-            if (IoError e = cachedMesh(file, mesh)) return e;
-            if (IoError e = ClosestTriangleIndex::build(*mesh, voxel, bandVoxels * voxel, v,
-                                                        file.path))
+            if (io::IoError e = cachedMesh(file, mesh)) return e;
+            if (io::IoError e =
+                    ClosestTriangleIndex::build(*mesh, voxel, bandVoxels * voxel, v, file.path))
                 return e;
             bytes = v->memoryBytes();
             return {};

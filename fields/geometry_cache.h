@@ -5,7 +5,7 @@
 
 #include "fields/geometry.h"
 #include "fields/geometry_paths.h"
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <cstddef>
 #include <functional>
@@ -23,7 +23,7 @@ public:
     struct Built {
         std::shared_ptr<const void> value;
         size_t bytes = 0;
-        IoError error;
+        io::IoError error;
     };
     using Builder = std::function<Built()>;
 
@@ -36,7 +36,7 @@ public:
     // missing file may appear later). Entries beyond the budget are dropped least recently used
     // first; a dropped value stays alive while something still holds it.
     template <class T, class F>
-    IoError get(const std::string& key, F&& build, std::shared_ptr<const T>& out) {
+    io::IoError get(const std::string& key, F&& build, std::shared_ptr<const T>& out) {
         Built b = getErased(key, [&]() -> Built {
             std::shared_ptr<const T> v;
             size_t bytes = 0;
@@ -73,11 +73,11 @@ private:
 
 // Loaders through GeometryCache::global(), keyed by the file's key (path, mtime, size) and the
 // build settings. Errors name the file.
-IoError cachedMesh(const FrameFile& file, std::shared_ptr<const TriangleMesh>& out);
-IoError cachedSdf(const FrameFile& file, double voxel, std::shared_ptr<const SdfVolume>& out);
-IoError cachedVelocity(const FrameFile& file, const std::string& gridName,
-                       std::shared_ptr<const VelocityVolume>& out);
-IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVoxels,
-                            std::shared_ptr<const ClosestTriangleIndex>& out);
+io::IoError cachedMesh(const FrameFile& file, std::shared_ptr<const TriangleMesh>& out);
+io::IoError cachedSdf(const FrameFile& file, double voxel, std::shared_ptr<const SdfVolume>& out);
+io::IoError cachedVelocity(const FrameFile& file, const std::string& gridName,
+                           std::shared_ptr<const VelocityVolume>& out);
+io::IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVoxels,
+                                std::shared_ptr<const ClosestTriangleIndex>& out);
 
 } // namespace gale::fields

@@ -160,7 +160,7 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
     }
     // A sequence: one run of '#'.
     std::string probe;
-    if (!framePath(file, 0, probe)) {
+    if (!io::framePath(file, 0, probe)) {
         error = "'" + name + "' has more than one run of '#'; a sequence has one (wind.#.vdb)";
         return false;
     }
@@ -190,7 +190,7 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
             continue;
         const long frame = std::stol(middle);
         std::string expected;
-        if (!framePath(file, frame, expected) || expected != entry) continue; // other padding
+        if (!io::framePath(file, frame, expected) || expected != entry) continue; // other padding
         std::error_code sec;
         if (!fs::is_regular_file(it->path(), sec)) continue;
         const fs::path canonical = canonicalOf(it->path());
@@ -211,7 +211,7 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
     }
     if (ref.frames.empty()) {
         std::string example;
-        framePath(file, 1, example);
+        io::framePath(file, 1, example);
         error = "no files of the sequence '" + name + "' in " + dir.string() +
                 " (frame 1 would be " + example + ")";
         return false;

@@ -2,9 +2,9 @@
 // within one voxel of the analytic distance, unit gradients along the analytic normal, the wind
 // shadow's bounds and monotonicity behind a sphere, closest points on triangles, mesh reading
 // (polygons fanned, errors) and the cache's once-per-key rule.
-#include "fields/test_support.h"
 #include "fields/geometry.h"
 #include "fields/geometry_cache.h"
+#include "io/test_support.h"
 
 #include <catch2/catch.hpp>
 
@@ -18,10 +18,11 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::io;
 
 namespace {
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 void writeText(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;

@@ -1,9 +1,9 @@
 // Tests for scene loading: every key of [scene], [windicator], [[gust]] and [[field]], keyframed
 // values, --set overrides by dotted path, and bad input reported at file:line:col (all of it,
 // with "did you mean"); then the scene's summed field built and sampled.
-#include "fields/test_support.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "io/test_support.h"
 
 #include <catch2/catch.hpp>
 
@@ -18,7 +18,7 @@ using namespace gale::fields;
 namespace {
 
 // A scratch folder per test, removed afterwards.
-using test::TempDir;
+using gale::io::test::TempDir;
 
 struct Loaded {
     Scene scene;

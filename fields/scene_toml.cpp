@@ -2,10 +2,10 @@
 // to compile): --set overrides applied to the TOML tree by dotted path, then every key checked
 // and converted, with every problem reported at its file:line:col.
 #include "fields/expression_field.h"
-#include "fields/pointset.h"
 #include "fields/presets.h"
 #include "fields/scene.h"
 #include "fields/scene_toml_util.h"
+#include "io/pointset.h"
 #include "lang/functions.h"
 
 #include <toml++/toml.h>
@@ -372,7 +372,7 @@ std::optional<Param> Loader::keyframes(const toml::table& t, const std::string& 
                      [](const Key& a, const Key& b) { return a.time < b.time; });
     for (size_t i = 1; i < list.size(); ++i) {
         if (list[i].time == list[i - 1].time) {
-            error(*list[i].node, what + ": two keys at time " + formatNumber(list[i].time) +
+            error(*list[i].node, what + ": two keys at time " + io::formatNumber(list[i].time) +
                                      " (each key needs its own time)");
             ok = false;
         }

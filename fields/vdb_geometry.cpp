@@ -3,7 +3,7 @@
 // shadow march) and the closest-triangle index grid behind meshvel().
 #include "fields/geometry.h"
 
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -26,9 +26,9 @@ void initOpenVdb() {
     (void)done;
 }
 
-IoError dataError(const std::string& name, const std::string& message) {
-    IoError e;
-    e.kind = IoError::Data;
+io::IoError dataError(const std::string& name, const std::string& message) {
+    io::IoError e;
+    e.kind = io::IoError::Data;
     e.file = name;
     e.message = message;
     return e;
@@ -72,9 +72,11 @@ double surfaceArea(const TriangleMesh& mesh) {
     return area;
 }
 
-std::string voxelText(double v) { return formatNumber(v); }
+std::string voxelText(double v) {
+    return io::formatNumber(v);
+}
 
-IoError checkBuildInputs(const TriangleMesh& mesh, double voxel, const std::string& name) {
+io::IoError checkBuildInputs(const TriangleMesh& mesh, double voxel, const std::string& name) {
     if (mesh.triangles.empty() || mesh.points.empty())
         return dataError(name, "the mesh has no triangles");
     if (!(voxel > 0.0) || !std::isfinite(voxel))
@@ -130,9 +132,9 @@ struct SdfVolume::Impl {
 SdfVolume::SdfVolume(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 SdfVolume::~SdfVolume() = default;
 
-IoError SdfVolume::build(const TriangleMesh& mesh, const SdfOptions& options,
-                         std::shared_ptr<const SdfVolume>& out, const std::string& name) {
-    if (IoError e = checkBuildInputs(mesh, options.voxel, name)) return e;
+io::IoError SdfVolume::build(const TriangleMesh& mesh, const SdfOptions& options,
+                             std::shared_ptr<const SdfVolume>& out, const std::string& name) {
+    if (io::IoError e = checkBuildInputs(mesh, options.voxel, name)) return e;
     const double voxel = options.voxel;
     const int bandVoxels =
         options.bandVoxels > 0 ? options.bandVoxels : automaticBandVoxels(mesh, voxel);
@@ -235,18 +237,18 @@ void SdfVolume::shadow(const double* xyz, const double* dir, const double* lengt
     }
 }
 
-IoError SdfVolume::writeVdb(const std::string& path, const std::string& gridName) const {
+io::IoError SdfVolume::writeVdb(const std::string& path, const std::string& gridName) const {
     openvdb::FloatGrid::Ptr grid = mImpl->grid->deepCopy();
     grid->setName(gridName);
     grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    return writeFileAtomic(path, [&](const std::string& tmp) -> IoError {
+    return io::writeFileAtomic(path, [&](const std::string& tmp) -> io::IoError {
         try {
             openvdb::io::File file(tmp);
             file.write(openvdb::GridPtrVec{grid});
             file.close();
         } catch (const std::exception& e) {
-            IoError err;
-            err.kind = IoError::Io;
+            io::IoError err;
+            err.kind = io::IoError::Io;
             err.file = path;
             err.message = std::string("cannot write: ") + e.what();
             return err;
@@ -272,10 +274,10 @@ struct ClosestTriangleIndex::Impl {
 ClosestTriangleIndex::ClosestTriangleIndex(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 ClosestTriangleIndex::~ClosestTriangleIndex() = default;
 
-IoError ClosestTriangleIndex::build(const TriangleMesh& mesh, double voxel, double reach,
-                                    std::shared_ptr<const ClosestTriangleIndex>& out,
-                                    const std::string& name) {
-    if (IoError e = checkBuildInputs(mesh, voxel, name)) return e;
+io::IoError ClosestTriangleIndex::build(const TriangleMesh& mesh, double voxel, double reach,
+                                        std::shared_ptr<const ClosestTriangleIndex>& out,
+                                        const std::string& name) {
+    if (io::IoError e = checkBuildInputs(mesh, voxel, name)) return e;
     const double bandVoxels = std::ceil(std::max(reach, 0.0) / voxel) + 2.0;
     const double estimate = surfaceArea(mesh) * 2.0 * bandVoxels / (voxel * voxel);
     if (estimate > kMaxSdfVoxels)

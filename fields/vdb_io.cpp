@@ -31,8 +31,8 @@ void initOpenVdb() {
     (void)done;
 }
 
-IoError makeError(IoError::Kind kind, const std::string& file, const std::string& message) {
-    IoError e;
+io::IoError makeError(io::IoError::Kind kind, const std::string& file, const std::string& message) {
+    io::IoError e;
     e.kind = kind;
     e.file = file;
     e.message = message;
@@ -69,7 +69,7 @@ std::string gridClassName(openvdb::GridClass c) {
 }
 
 // Index (0,0,0) at the centre of cell (0,0,0); a scale by the voxel size per axis.
-openvdb::math::Transform::Ptr cellCentredTransform(const GridSpec& grid) {
+openvdb::math::Transform::Ptr cellCentredTransform(const io::GridSpec& grid) {
     const openvdb::Vec3d voxel(grid.voxel[0], grid.voxel[1], grid.voxel[2]);
     const openvdb::Vec3d first(grid.origin[0] + 0.5 * grid.voxel[0],
                                grid.origin[1] + 0.5 * grid.voxel[1],
@@ -88,10 +88,10 @@ openvdb::math::Transform::Ptr cellCentredTransform(const GridSpec& grid) {
 
 } // namespace
 
-IoError writeVdbVelocity(const std::string& path, const GridSpec& spec,
-                         const std::vector<float>& values, const VdbWriteOptions& options) {
+io::IoError writeVdbVelocity(const std::string& path, const io::GridSpec& spec,
+                             const std::vector<float>& values, const VdbWriteOptions& options) {
     if (values.size() != 3 * spec.cellCount())
-        return makeError(IoError::Data, path,
+        return makeError(io::IoError::Data, path,
                          "the grid has " + std::to_string(spec.cellCount()) + " cells but " +
                              std::to_string(values.size()) + " values were given (3 per cell)");
     initOpenVdb();
@@ -124,11 +124,11 @@ IoError writeVdbVelocity(const std::string& path, const GridSpec& spec,
         });
         openvdb::tools::prune(tree);
     } catch (const std::exception& e) {
-        return makeError(IoError::Data, path,
+        return makeError(io::IoError::Data, path,
                          std::string("cannot build the VDB grid: ") + e.what());
     }
 
-    return writeFileAtomic(path, [&](const std::string& tmp) -> IoError {
+    return io::writeFileAtomic(path, [&](const std::string& tmp) -> io::IoError {
         try {
             openvdb::GridPtrVec grids{grid};
             openvdb::MetaMap fileMeta;
@@ -137,7 +137,7 @@ IoError writeVdbVelocity(const std::string& path, const GridSpec& spec,
             file.write(grids, fileMeta);
             file.close();
         } catch (const std::exception& e) {
-            return makeError(IoError::Io, path, std::string("cannot write: ") + e.what());
+            return makeError(io::IoError::Io, path, std::string("cannot write: ") + e.what());
         }
         return {};
     });
@@ -155,32 +155,33 @@ openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
     return stream.getGrids();
 }
 
-IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out) {
+io::IoError readVdbVelocity(const std::string& path, const std::string& gridName,
+                            VdbVelocity& out) {
     initOpenVdb();
     openvdb::GridPtrVecPtr grids;
     try {
         grids = readAllGrids(path);
     } catch (const std::exception& e) {
-        return makeError(IoError::Io, path, std::string("cannot read: ") + e.what());
+        return makeError(io::IoError::Io, path, std::string("cannot read: ") + e.what());
     }
     openvdb::Vec3SGrid::Ptr grid;
     for (const openvdb::GridBase::Ptr& g : *grids) {
         if (!gridName.empty() && g->getName() != gridName) continue;
         grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
         if (!grid && !gridName.empty())
-            return makeError(IoError::Data, path,
+            return makeError(io::IoError::Data, path,
                              "grid '" + gridName + "' holds " + g->valueType() +
                                  " values, not vec3s");
         if (grid) break;
     }
     if (!grid)
-        return makeError(IoError::Data, path,
+        return makeError(io::IoError::Data, path,
                          gridName.empty() ? std::string("the file has no vec3s grid")
                                           : "the file has no grid named '" + gridName + "'");
 
     const openvdb::math::Transform& xf = grid->transform();
     if (!xf.isLinear())
-        return makeError(IoError::Data, path,
+        return makeError(io::IoError::Data, path,
                          "grid '" + grid->getName() + "' has a non-linear (frustum) transform");
     const openvdb::Vec3d o = xf.indexToWorld(openvdb::Vec3d(0.0));
     openvdb::Vec3d voxel;
@@ -190,22 +191,22 @@ IoError readVdbVelocity(const std::string& path, const std::string& gridName, Vd
         const openvdb::Vec3d d = xf.indexToWorld(unit) - o;
         for (int b = 0; b < 3; ++b)
             if (b != a && std::abs(d[b]) > 1e-12 * std::abs(d[a]))
-                return makeError(IoError::Data, path,
+                return makeError(io::IoError::Data, path,
                                  "grid '" + grid->getName() +
                                      "' has a rotated or sheared transform");
         if (!(d[a] > 0))
-            return makeError(IoError::Data, path,
+            return makeError(io::IoError::Data, path,
                              "grid '" + grid->getName() + "' has a mirrored transform");
         voxel[a] = d[a];
     }
     const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
     if (box.empty())
-        return makeError(IoError::Data, path,
+        return makeError(io::IoError::Data, path,
                          "grid '" + grid->getName() + "' has no active voxels");
     const openvdb::Coord dim = box.dim();
     const double cells = static_cast<double>(dim.x()) * dim.y() * dim.z();
-    if (cells > static_cast<double>(kMaxGridCells))
-        return makeError(IoError::Data, path,
+    if (cells > static_cast<double>(io::kMaxGridCells))
+        return makeError(io::IoError::Data, path,
                          "grid '" + grid->getName() + "' is too large to read densely");
 
     VdbVelocity r;
@@ -232,7 +233,8 @@ IoError readVdbVelocity(const std::string& path, const std::string& gridName, Vd
         for (size_t i = 0; i < r.grid.cellCount(); ++i)
             for (int c = 0; c < 3; ++c) r.values[3 * i + static_cast<size_t>(c)] = src[i][c];
     } catch (const std::exception& e) {
-        return makeError(IoError::Data, path, std::string("cannot read the voxels: ") + e.what());
+        return makeError(io::IoError::Data, path,
+                         std::string("cannot read the voxels: ") + e.what());
     }
     out = std::move(r);
     return {};
@@ -257,32 +259,32 @@ std::string gridList(const openvdb::GridPtrVec& grids) {
 }
 
 // Picks the grid from descriptors or loaded grids; an error when absent or of the wrong type.
-IoError pickVectorGrid(const std::string& path, const std::string& gridName,
-                       const openvdb::GridPtrVec& grids, openvdb::GridBase::Ptr& out) {
+io::IoError pickVectorGrid(const std::string& path, const std::string& gridName,
+                           const openvdb::GridPtrVec& grids, openvdb::GridBase::Ptr& out) {
     for (const openvdb::GridBase::Ptr& g : grids) {
         if (!gridName.empty() && g->getName() != gridName) continue;
         if (!isVectorGrid(*g)) {
             if (gridName.empty()) continue;
-            return makeError(IoError::Data, path,
+            return makeError(io::IoError::Data, path,
                              "grid '" + gridName + "' holds " + g->valueType() +
                                  " values, not vectors (vec3s or vec3d)");
         }
         if (!g->transform().isLinear())
-            return makeError(IoError::Data, path,
+            return makeError(io::IoError::Data, path,
                              "grid '" + g->getName() + "' has a non-linear (frustum) transform");
         out = g;
         return {};
     }
-    return makeError(IoError::Data, path,
+    return makeError(io::IoError::Data, path,
                      (gridName.empty() ? std::string("the file has no vector grid")
                                        : "the file has no grid named '" + gridName + "'") +
                          " (its grids: " + gridList(grids) + ")");
 }
 
-IoError readFailure(const std::string& path, const std::exception& e) {
+io::IoError readFailure(const std::string& path, const std::exception& e) {
     std::string what = e.what();
     if (what.empty()) what = "unknown error";
-    return makeError(IoError::Io, path,
+    return makeError(io::IoError::Io, path,
                      "cannot read the VDB file (missing, truncated or corrupt): " + what);
 }
 
@@ -297,7 +299,7 @@ struct VelocityVolume::Impl {
 VelocityVolume::VelocityVolume(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 VelocityVolume::~VelocityVolume() = default;
 
-IoError checkVdbGrid(const std::string& path, const std::string& gridName) {
+io::IoError checkVdbGrid(const std::string& path, const std::string& gridName) {
     initOpenVdb();
     try {
         openvdb::GridPtrVecPtr grids = readAllGrids(path);
@@ -308,14 +310,14 @@ IoError checkVdbGrid(const std::string& path, const std::string& gridName) {
     }
 }
 
-IoError VelocityVolume::load(const std::string& path, const std::string& gridName,
-                             std::shared_ptr<const VelocityVolume>& out) {
+io::IoError VelocityVolume::load(const std::string& path, const std::string& gridName,
+                                 std::shared_ptr<const VelocityVolume>& out) {
     initOpenVdb();
     openvdb::GridBase::Ptr grid;
     try {
         // Everything is read now: a truncated file fails here, not mid-sample.
         openvdb::GridPtrVecPtr grids = readAllGrids(path);
-        if (IoError e = pickVectorGrid(path, gridName, *grids, grid)) return e;
+        if (io::IoError e = pickVectorGrid(path, gridName, *grids, grid)) return e;
     } catch (const std::exception& e) {
         return readFailure(path, e);
     }
@@ -328,7 +330,7 @@ IoError VelocityVolume::load(const std::string& path, const std::string& gridNam
         impl->grid->setTree(std::make_shared<openvdb::Vec3STree>(d->tree()));
         impl->grid->setTransform(d->transform().copy());
     } else {
-        return makeError(IoError::Data, path, "grid '" + impl->name + "' is not a vector grid");
+        return makeError(io::IoError::Data, path, "grid '" + impl->name + "' is not a vector grid");
     }
     impl->memoryBytes = static_cast<size_t>(impl->grid->memUsage());
     out = std::shared_ptr<const VelocityVolume>(new VelocityVolume(std::move(impl)));

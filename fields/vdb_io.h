@@ -5,7 +5,7 @@
 #pragma once
 
 #include "fields/grid_sample.h"
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <map>
 #include <string>
@@ -28,8 +28,8 @@ struct VdbWriteOptions {
 // active (runs of equal values are stored as tiles); the background is zero; vector type
 // VEC_CONTRAVARIANT_RELATIVE; grid class unknown (not a level set or fog volume).
 // Written through a temporary file and a rename.
-IoError writeVdbVelocity(const std::string& path, const GridSpec& grid,
-                         const std::vector<float>& values, const VdbWriteOptions& options = {});
+io::IoError writeVdbVelocity(const std::string& path, const io::GridSpec& grid,
+                             const std::vector<float>& values, const VdbWriteOptions& options = {});
 
 // A Vec3s grid read back: the box of its active voxels as a dense array.
 struct VdbVelocity {
@@ -37,7 +37,7 @@ struct VdbVelocity {
     std::string vectorType;             // "invariant", "covariant", "covariant-normalize",
                                         // "contravariant-relative", "contravariant-absolute"
     std::string gridClass;              // "unknown", "level set", "fog volume", "staggered"
-    GridSpec grid;                      // origin = min corner of the active box's first voxel
+    io::GridSpec grid;                  // origin = min corner of the active box's first voxel
     std::vector<int> indexMin{0, 0, 0}; // index coordinates of the box's first voxel
     std::vector<float> values;          // 3 per cell, x slowest (like sampleGrid)
     std::map<std::string, std::string> metadata; // every grid metadata item, as text
@@ -47,6 +47,6 @@ struct VdbVelocity {
 // Reads the Vec3s grid named `gridName` (empty: the first Vec3s grid) from a .vdb file.
 // Errors: Io when the file cannot be opened or is not a VDB file; Data when the grid is
 // missing, is not Vec3s, has a non-linear or rotated transform, or is empty.
-IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out);
+io::IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out);
 
 } // namespace gale::fields

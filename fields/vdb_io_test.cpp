@@ -1,8 +1,8 @@
 // Tests for the .vdb velocity files: a written grid read back has the same values, voxel size,
 // origin, name, vector type and box (uniform regions included); errors for missing files,
 // missing grids and wrong value counts.
-#include "fields/test_support.h"
 #include "fields/vdb_io.h"
+#include "io/test_support.h"
 
 #include <catch2/catch.hpp>
 
@@ -12,10 +12,11 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::io;
 
 namespace {
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 // Values derived from the cell index (not from any sampling code): distinct per cell and
 // component, with a zero region (cells with i == 0) and a constant region (i == nx-1).

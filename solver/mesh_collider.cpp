@@ -11,7 +11,7 @@ std::shared_ptr<const MeshCollider> MeshCollider::load(const std::string& path, 
     fields::FrameFile file;
     if (!fields::frameFileFor(path, file, error)) return nullptr;
     std::shared_ptr<const fields::SdfVolume> sdf;
-    if (fields::IoError e = fields::cachedSdf(file, voxel, sdf)) {
+    if (io::IoError e = fields::cachedSdf(file, voxel, sdf)) {
         error = "cannot use '" + path + "' as a collider: " + e.message;
         return nullptr;
     }

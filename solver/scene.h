@@ -3,8 +3,8 @@
 // turned into bodies: meshes and strands loaded, painted maps evaluated, pins resolved.
 #pragma once
 
-#include "fields/pointset.h"
 #include "fields/scene.h"
+#include "io/pointset.h"
 #include "solver/cloth.h"
 #include "solver/hair.h"
 #include "solver/world.h"
@@ -106,6 +106,6 @@ WorldSettings worldSettings(const SimScene& scene, int threads);
 // A body's current shape for output: OBJ text (`v` lines, then `f` for cloth or `l` for
 // strands), or a point set with faces (cloth) or a `strand` column (hair) for PLY.
 std::string bodyObjText(const Body& body);
-fields::PointSet bodyPointSet(const Body& body);
+io::PointSet bodyPointSet(const Body& body);
 
 } // namespace gale::solver

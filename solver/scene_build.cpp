@@ -296,8 +296,8 @@ std::string bodyObjText(const Body& body) {
     return out;
 }
 
-fields::PointSet bodyPointSet(const Body& body) {
-    fields::PointSet ps;
+io::PointSet bodyPointSet(const Body& body) {
+    io::PointSet ps;
     const VecX& x = body.positions();
     const VecX& v = body.velocities();
     const char* names[6] = {"x", "y", "z", "vx", "vy", "vz"};

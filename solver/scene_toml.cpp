@@ -223,8 +223,8 @@ bool Loader::number(const toml::node& n, const std::string& what, double& out, d
         return false;
     }
     if (strictMin ? !(v > min) : !(v >= min)) {
-        error(n, what + " must be " + (strictMin ? "greater than " : "at least ") + fields::formatNumber(min) +
-                     ", not " + fields::formatNumber(v));
+        error(n, what + " must be " + (strictMin ? "greater than " : "at least ") +
+                     io::formatNumber(min) + ", not " + io::formatNumber(v));
         return false;
     }
     out = v;
@@ -372,7 +372,7 @@ std::optional<fields::Param> Loader::keyframes(const toml::table& t, const std::
         }
         for (const auto& e : list)
             if (e.first == time) {
-                error(k, what + ": two keys at time " + fields::formatNumber(time));
+                error(k, what + ": two keys at time " + io::formatNumber(time));
                 ok = false;
             }
         list.push_back({time, std::move(value)});

@@ -1,13 +1,13 @@
 // Helpers shared by the point-set readers and writers (pointset.cpp, pointset_ply.cpp).
-// Internal to gale::fields: not part of the public API.
+// Internal to gale::io: not part of the public API.
 #pragma once
 
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <iosfwd>
 #include <string>
 
-namespace gale::fields::detail {
+namespace gale::io::detail {
 
 IoError dataError(const std::string& file, int line, int col, std::string message);
 IoError ioError(const std::string& file, std::string message);
@@ -19,4 +19,4 @@ void appendNumber(std::string& out, double v, bool asFloat32);
 // PLY writer (binary little-endian or ascii); every column becomes a `float` property.
 IoError writePly(std::ostream& out, const PointSet& points, bool binary);
 
-} // namespace gale::fields::detail
+} // namespace gale::io::detail

@@ -1,9 +1,9 @@
 // Point sets: CSV and OBJ readers, CSV/JSON/NPY/OBJ writers, the atomic file writer, number
 // formatting and the host variables a point set provides. PLY lives in pointset_ply.cpp.
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
-#include "fields/atomic_file.h"
-#include "fields/pointset_detail.h"
+#include "io/atomic_file.h"
+#include "io/pointset_detail.h"
 
 #include <tiny_obj_loader.h>
 
@@ -24,7 +24,7 @@
 #include <type_traits>
 #include <unistd.h>
 
-namespace gale::fields {
+namespace gale::io {
 
 using detail::dataError;
 using detail::ioError;
@@ -317,9 +317,11 @@ IoError readPointsObj(const std::string& path, PointSet& out) {
             for (int v : face)
                 if (v < 0 || static_cast<size_t>(v) >= n)
                     return dataError(path, 0, 0,
-                                     "face " + std::to_string(out.faces.size() + 1) + " refers to vertex " +
-                                         std::to_string(static_cast<long long>(v) + 1) + " (counting from 1), but there are " +
-                                         std::to_string(n) + " vertices: fix its f line");
+                                     "face " + std::to_string(out.faces.size() + 1) +
+                                         " refers to vertex " +
+                                         std::to_string(static_cast<long long>(v) + 1) +
+                                         " (counting from 1), but there are " + std::to_string(n) +
+                                         " vertices: fix its f line");
             out.faces.push_back(std::move(face));
         }
     }
@@ -352,7 +354,6 @@ IoError writeCsv(std::ostream& out, const PointSet& ps, bool header = true) {
     out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
     return {};
 }
-
 
 IoError writeJson(std::ostream& out, const PointSet& ps) {
     std::vector<std::string> keys;
@@ -569,4 +570,4 @@ std::string jsonString(const std::string& s) {
     return out;
 }
 
-} // namespace gale::fields
+} // namespace gale::io

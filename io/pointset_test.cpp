@@ -1,7 +1,7 @@
 // Tests for point-set I/O: round trips through every format, arbitrary and big-endian PLY,
 // faces, malformed files reported at the right line, number formatting, host variables.
-#include "fields/test_support.h"
-#include "fields/pointset.h"
+#include "io/pointset.h"
+#include "io/test_support.h"
 
 #include <catch2/catch.hpp>
 
@@ -15,7 +15,7 @@
 #include <sstream>
 #include <unistd.h>
 
-using namespace gale::fields;
+using namespace gale::io;
 
 namespace {
 

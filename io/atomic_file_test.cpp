@@ -1,7 +1,7 @@
 // Tests for removeStaleTempFiles: temporary files of killed writers (dead or zombie pids) are
 // removed, those of running processes and names the caller does not own are kept.
-#include "fields/test_support.h"
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
+#include "io/test_support.h"
 
 #include <catch2/catch.hpp>
 
@@ -13,7 +13,7 @@
 #include <thread>
 #include <unistd.h>
 
-using namespace gale::fields;
+using namespace gale::io;
 namespace fs = std::filesystem;
 
 namespace {
@@ -38,7 +38,8 @@ pid_t exitedChild(bool reap) {
             std::string text;
             std::getline(stat, text);
             const size_t paren = text.rfind(')');
-            if (paren != std::string::npos && paren + 2 < text.size() && text[paren + 2] == 'Z') break;
+            if (paren != std::string::npos && paren + 2 < text.size() && text[paren + 2] == 'Z')
+                break;
             std::this_thread::sleep_for(std::chrono::milliseconds(1));
         }
     }
@@ -58,14 +59,15 @@ TEST_CASE("stale temporary files of killed writers are removed", "[atomic]") {
     dir.touch("cape.0005.obj.tmp." + self);
     dir.touch("cape.0006.obj.tmp." + parent);
     dir.touch("notes.txt.tmp." + std::to_string(dead)); // not ours
-    dir.touch("cape.0007.obj.tmp.x12");                  // not a pid
-    dir.touch("cape.0008.obj");                          // a frame
+    dir.touch("cape.0007.obj.tmp.x12");                 // not a pid
+    dir.touch("cape.0008.obj");                         // a frame
 
     std::vector<std::string> asked;
-    const std::vector<std::string> removed = removeStaleTempFiles(dir.path.string(), [&](const std::string& target) {
-        asked.push_back(target);
-        return target.rfind("cape.", 0) == 0;
-    });
+    const std::vector<std::string> removed =
+        removeStaleTempFiles(dir.path.string(), [&](const std::string& target) {
+            asked.push_back(target);
+            return target.rfind("cape.", 0) == 0;
+        });
     int status = 0;
     ::waitpid(zombie, &status, 0);
 
@@ -83,5 +85,7 @@ TEST_CASE("stale temporary files of killed writers are removed", "[atomic]") {
 }
 
 TEST_CASE("a missing folder has no stale files", "[atomic]") {
-    CHECK(removeStaleTempFiles("/nonexistent/gale/folder", [](const std::string&) { return true; }).empty());
+    CHECK(removeStaleTempFiles("/nonexistent/gale/folder", [](const std::string&) {
+              return true;
+          }).empty());
 }

@@ -1,8 +1,8 @@
 // PLY point sets: a reader for ascii and binary (little/big-endian) files with arbitrary vertex
 // properties, a kept face element and skipped other elements; a writer (binary little-endian
 // or ascii) that stores every column as a float property, plus the faces.
-#include "fields/pointset.h"
-#include "fields/pointset_detail.h"
+#include "io/pointset.h"
+#include "io/pointset_detail.h"
 
 #include <algorithm>
 #include <cctype>
@@ -16,7 +16,7 @@
 #include <set>
 #include <string_view>
 
-namespace gale::fields {
+namespace gale::io {
 
 using detail::dataError;
 using detail::ioError;
@@ -537,4 +537,4 @@ IoError writePly(std::ostream& out, const PointSet& ps, bool binary) {
 
 } // namespace detail
 
-} // namespace gale::fields
+} // namespace gale::io

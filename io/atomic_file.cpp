@@ -1,5 +1,5 @@
 // Atomic file writes: temporary name + rename, with devices, pipes and symbolic links handled.
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
 
 #include <cctype>
 #include <cerrno>
@@ -10,7 +10,7 @@
 #include <signal.h>
 #include <unistd.h>
 
-namespace gale::fields {
+namespace gale::io {
 
 IoError ioErrorAt(const std::string& file, const std::string& what, int err) {
     IoError e;
@@ -81,18 +81,23 @@ bool processRuns(long pid) {
 
 } // namespace
 
-std::vector<std::string> removeStaleTempFiles(const std::string& folder,
-                                              const std::function<bool(const std::string& target)>& isOurs) {
+std::vector<std::string>
+removeStaleTempFiles(const std::string& folder,
+                     const std::function<bool(const std::string& target)>& isOurs) {
     namespace fs = std::filesystem;
     std::vector<fs::path> stale;
     std::error_code ec;
-    for (fs::directory_iterator it(folder.empty() ? "." : folder, ec), end; !ec && it != end; it.increment(ec)) {
+    for (fs::directory_iterator it(folder.empty() ? "." : folder, ec), end; !ec && it != end;
+         it.increment(ec)) {
         if (!it->is_regular_file(ec)) continue;
         const std::string name = it->path().filename().string();
         const size_t mark = name.rfind(".tmp.");
-        if (mark == std::string::npos || mark == 0 || mark + 5 == name.size() || name.size() - mark - 5 > 9) continue;
+        if (mark == std::string::npos || mark == 0 || mark + 5 == name.size() ||
+            name.size() - mark - 5 > 9)
+            continue;
         bool digits = true;
-        for (size_t i = mark + 5; i < name.size(); ++i) digits = digits && std::isdigit(static_cast<unsigned char>(name[i]));
+        for (size_t i = mark + 5; i < name.size(); ++i)
+            digits = digits && std::isdigit(static_cast<unsigned char>(name[i]));
         if (!digits) continue;
         const long pid = std::stol(name.substr(mark + 5));
         if (pid <= 0 || pid == static_cast<long>(::getpid()) || processRuns(pid)) continue;
@@ -104,4 +109,4 @@ std::vector<std::string> removeStaleTempFiles(const std::string& folder,
     return removed;
 }
 
-} // namespace gale::fields
+} // namespace gale::io

@@ -9,7 +9,7 @@
 #include <system_error>
 #include <unistd.h>
 
-namespace gale::fields::test {
+namespace gale::io::test {
 
 class TempDir {
 public:
@@ -17,8 +17,7 @@ public:
     TempDir() {
         static std::atomic<int> counter{0};
         path = std::filesystem::canonical(std::filesystem::temp_directory_path()) /
-               ("gale_fields_test_" + std::to_string(::getpid()) + "_" +
-                std::to_string(counter++));
+               ("gale_fields_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
         std::filesystem::create_directories(path);
     }
     ~TempDir() {
@@ -40,4 +39,4 @@ public:
     std::filesystem::path path;
 };
 
-} // namespace gale::fields::test
+} // namespace gale::io::test

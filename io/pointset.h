@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace gale::fields {
+namespace gale::io {
 
 struct PointSet {
     std::vector<std::string> names;           // column names, in file order
@@ -103,4 +103,4 @@ struct PointVariable {
 };
 std::vector<PointVariable> pointVariables(const PointSet& points);
 
-} // namespace gale::fields
+} // namespace gale::io

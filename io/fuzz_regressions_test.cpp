@@ -1,6 +1,6 @@
 // Regressions found by the libFuzzer harnesses (fuzz/, docs/fuzzing.md) in the field layer's
 // readers and scene loader: each case is an input that once crashed or broke a property.
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <catch2/catch.hpp>
 
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-using namespace gale::fields;
+using namespace gale::io;
 
 namespace {
 
@@ -19,7 +19,8 @@ namespace {
 struct TempFile {
     std::filesystem::path dir, path;
     TempFile(const std::string& name, const std::string& text) {
-        dir = std::filesystem::temp_directory_path() / ("gale_fuzz_reg_" + std::to_string(getpid()));
+        dir =
+            std::filesystem::temp_directory_path() / ("gale_fuzz_reg_" + std::to_string(getpid()));
         std::filesystem::create_directories(dir);
         path = dir / name;
         std::ofstream(path, std::ios::binary) << text;
@@ -71,7 +72,8 @@ TEST_CASE("OBJ faces must name existing vertices, like PLY faces", "[fuzz][point
 // fuzz_readers: CSV columns "a b" and "a_b" were both written to PLY as property "a_b" (a PLY
 // name has no spaces), and the PLY reader rejects a property declared twice. Now the second
 // one is "a_b_2"; control characters in names are replaced too.
-TEST_CASE("PLY property names are made unique and free of spaces and controls", "[fuzz][pointset][ply]") {
+TEST_CASE("PLY property names are made unique and free of spaces and controls",
+          "[fuzz][pointset][ply]") {
     std::istringstream csv("a b,a_b,c\td\n1,2,3\n");
     PointSet ps;
     IoError e = readPointsCsv(csv, "names.csv", ps);
