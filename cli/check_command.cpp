@@ -78,7 +78,7 @@ int runCheck(const CheckOptions& options) {
         Bindings local = bindings;
         const lang::SourceFile compiled = bindParameters(source, local);
         local.addSets(sets);
-        const fields::FileAccess files = fields::fileAccessFor(file, options.allowPaths);
+        const geometry::FileAccess files = geometry::fileAccessFor(file, options.allowPaths);
         if (!compileAndReport(compiled, local.variables(), wantWidthFor(options.type), &source,
                               &files))
             sawError = true;

@@ -250,7 +250,7 @@ void Bindings::fillRequest(runtime::EvalRequest& request) const {
 
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth, const lang::SourceFile* shown, const fields::FileAccess* files) {
+                 int wantWidth, const lang::SourceFile* shown, const geometry::FileAccess* files) {
     runtime::CompileSettings settings;
     settings.variables = variables;
     settings.wantWidth = wantWidth;

@@ -20,9 +20,9 @@ class App;
 class Option;
 } // namespace CLI
 
-namespace gale::fields {
+namespace gale::geometry {
 struct FileAccess;
-} // namespace gale::fields
+} // namespace gale::geometry
 
 namespace gale::cli {
 
@@ -90,7 +90,7 @@ private:
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
                  int wantWidth, const lang::SourceFile* shown = nullptr,
-                 const fields::FileAccess* files = nullptr);
+                 const geometry::FileAccess* files = nullptr);
 
 // Adds `--allow-path DIR` (repeatable) to a subcommand.
 void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths);

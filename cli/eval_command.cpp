@@ -445,7 +445,7 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     const lang::SourceFile compiled = bindParameters(source, bindings);
     bindings.addSets(sets);
 
-    const fields::FileAccess files = fields::fileAccessFor(o.source.file, o.source.allowPaths);
+    const geometry::FileAccess files = geometry::fileAccessFor(o.source.file, o.source.allowPaths);
     std::shared_ptr<const runtime::Program> program = compileAndReport(
         compiled, bindings.variables(), wantWidthFor(o.source.type), &source, &files);
     if (!program) return kExitInput;

@@ -67,7 +67,7 @@ int loadExpression(const SourceOptions& source, FieldInput& out) {
     const std::vector<fields::ParameterDecl> declared = fields::findParameters(file);
     fields::ExpressionFieldOptions options;
     options.precision = runtime::Precision::Float;
-    options.files = fields::fileAccessFor(source.file, source.allowPaths);
+    options.files = geometry::fileAccessFor(source.file, source.allowPaths);
     std::vector<runtime::UniformValue> extras;
     for (const SetValue& s : sets) {
         const bool isParameter =

@@ -4,7 +4,7 @@
 #include "cli/common.h"
 #include "cli/field_input.h"
 #include "fields/grid_sample.h"
-#include "fields/vdb_io.h"
+#include "geometry/vdb_io.h"
 
 #include <CLI/CLI.hpp>
 
@@ -79,12 +79,12 @@ int writeOutput(const SampleOptions& o, const std::string& path, io::GridFormat 
     }
     io::IoError e;
     if (format == io::GridFormat::Vdb) {
-        fields::VdbWriteOptions vdb;
+        geometry::VdbWriteOptions vdb;
         vdb.metadata["gale_source"] = input.name;
         vdb.floatMetadata["gale_time"] = t;
         vdb.floatMetadata["gale_frame"] = frame;
         vdb.floatMetadata["gale_fps"] = input.fps;
-        e = fields::writeVdbVelocity(path, grid, values, vdb);
+        e = geometry::writeVdbVelocity(path, grid, values, vdb);
     } else {
         e = io::writeGridFile(path, format, grid, values);
     }

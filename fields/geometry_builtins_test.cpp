@@ -3,7 +3,7 @@
 // resolve names against their folder, and every misuse is a diagnostic at the argument's
 // file:line:col naming the file (missing, outside the folder, not constant, varying settings).
 #include "fields/expression_field.h"
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 #include "io/test_support.h"
 #include "lang/diagnostics.h"
 
@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::geometry;
 namespace fs = std::filesystem;
 
 namespace {

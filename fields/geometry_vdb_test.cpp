@@ -3,8 +3,9 @@
 // bound; `gale sample`'s .vdb reads back identically at cell centres; `#` sequences blend
 // frames; missing, truncated, garbage and wrong-grid files are clear errors.
 #include "fields/expression_field.h"
-#include "fields/geometry.h"
-#include "fields/vdb_io.h"
+#include "fields/grid_sample.h"
+#include "geometry/geometry.h"
+#include "geometry/vdb_io.h"
 #include "io/test_support.h"
 #include "lang/diagnostics.h"
 
@@ -18,6 +19,7 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::geometry;
 using namespace gale::io;
 namespace fs = std::filesystem;
 

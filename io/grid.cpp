@@ -199,7 +199,7 @@ IoError writeGridFile(const std::string& path, GridFormat format, const GridSpec
         IoError e;
         e.kind = IoError::Data;
         e.file = path;
-        e.message = "write .vdb files with writeVdbVelocity (fields/vdb_io.h)";
+        e.message = "write .vdb files with writeVdbVelocity (geometry/vdb_io.h)";
         return e;
     }
     return writeFileAtomic(path, [&](const std::string& tmp) -> IoError {

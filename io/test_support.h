@@ -1,5 +1,5 @@
-// Test support shared by the fields/ unit tests: a private temporary folder, removed with
-// everything in it when the test ends.
+// Test support shared by the io/, geometry/ and fields/ unit tests: a private temporary folder,
+// removed with everything in it when the test ends.
 #pragma once
 
 #include <atomic>

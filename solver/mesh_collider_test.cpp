@@ -1,7 +1,7 @@
 // Mesh colliders: the SDF of a box mesh against the analytic box distance and face normals,
 // the same through queryCollider, cloth draped over a mesh sphere staying outside it (within a
 // voxel), and the scene loader's [[collider]] type = "mesh" with its errors.
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 #include "solver/cloth.h"
 #include "solver/collider.h"
 #include "solver/mesh_collider.h"
@@ -41,9 +41,8 @@ double boxDistance(const Vec3& p, const Vec3& h) {
 TEST_CASE("mesh collider: distance and normal of a box mesh", "[collider][mesh]") {
     TempDir dir;
     const Vec3 h(0.3, 0.2, 0.25);
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(dir.file("box.obj"),
-                                                     gale::fields::boxMesh({-0.3, -0.2, -0.25},
-                                                                           {0.3, 0.2, 0.25})));
+    REQUIRE_FALSE(gale::geometry::writeTriangleMeshObj(
+        dir.file("box.obj"), gale::geometry::boxMesh({-0.3, -0.2, -0.25}, {0.3, 0.2, 0.25})));
     std::string error;
     const double voxel = 0.01;
     auto mesh = MeshCollider::load(dir.file("box.obj"), voxel, error);
@@ -80,8 +79,8 @@ TEST_CASE("mesh collider: distance and normal of a box mesh", "[collider][mesh]"
 
 TEST_CASE("mesh collider: cloth draped over a mesh sphere stays outside it", "[collider][mesh]") {
     TempDir dir;
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
-        dir.file("ball.obj"), gale::fields::uvSphereMesh({0, 0, 0}, 0.4, 24, 48)));
+    REQUIRE_FALSE(gale::geometry::writeTriangleMeshObj(
+        dir.file("ball.obj"), gale::geometry::uvSphereMesh({0, 0, 0}, 0.4, 24, 48)));
     std::string error;
     const double voxel = 0.02;
     auto ball = MeshCollider::load(dir.file("ball.obj"), voxel, error);
@@ -116,8 +115,8 @@ TEST_CASE("mesh collider: cloth draped over a mesh sphere stays outside it", "[c
 
 TEST_CASE("mesh collider in a scene: [[collider]] type = \"mesh\"", "[collider][mesh][scene]") {
     TempDir dir;
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
-        dir.file("body.obj"), gale::fields::boxMesh({-0.2, 0, -0.1}, {0.2, 1.6, 0.1})));
+    REQUIRE_FALSE(gale::geometry::writeTriangleMeshObj(
+        dir.file("body.obj"), gale::geometry::boxMesh({-0.2, 0, -0.1}, {0.2, 1.6, 0.1})));
     auto load = [&](const std::string& text, SimScene& scene, std::string& all) {
         std::ofstream(dir.file("scene.toml")) << text;
         std::vector<gale::fields::SceneError> errors;

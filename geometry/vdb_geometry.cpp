@@ -1,7 +1,7 @@
 // Mesh geometry through OpenVDB (one of the two translation units that include its slow
 // headers): narrow-band SDFs from meshToLevelSet, their sampling (distance, gradient, the wind
 // shadow march) and the closest-triangle index grid behind meshvel().
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 
 #include "io/atomic_file.h"
 
@@ -14,7 +14,7 @@
 #include <cmath>
 #include <exception>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 namespace {
 
@@ -51,8 +51,8 @@ bool toVdb(const TriangleMesh& mesh, std::vector<openvdb::Vec3s>& points,
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
         for (int k = 0; k < 3; ++k)
             if (mesh.triangles[i][k] >= mesh.points.size()) return false;
-        triangles[i] = openvdb::Vec3I(mesh.triangles[i][0], mesh.triangles[i][1],
-                                      mesh.triangles[i][2]);
+        triangles[i] =
+            openvdb::Vec3I(mesh.triangles[i][0], mesh.triangles[i][1], mesh.triangles[i][2]);
     }
     return true;
 }
@@ -257,11 +257,21 @@ io::IoError SdfVolume::writeVdb(const std::string& path, const std::string& grid
     });
 }
 
-double SdfVolume::voxel() const { return mImpl->voxel; }
-double SdfVolume::band() const { return mImpl->band; }
-const std::array<double, 6>& SdfVolume::meshBounds() const { return mImpl->box; }
-size_t SdfVolume::activeVoxels() const { return mImpl->activeVoxels; }
-size_t SdfVolume::memoryBytes() const { return mImpl->memoryBytes; }
+double SdfVolume::voxel() const {
+    return mImpl->voxel;
+}
+double SdfVolume::band() const {
+    return mImpl->band;
+}
+const std::array<double, 6>& SdfVolume::meshBounds() const {
+    return mImpl->box;
+}
+size_t SdfVolume::activeVoxels() const {
+    return mImpl->activeVoxels;
+}
+size_t SdfVolume::memoryBytes() const {
+    return mImpl->memoryBytes;
+}
 
 // ---- ClosestTriangleIndex ----
 
@@ -335,7 +345,11 @@ void ClosestTriangleIndex::candidates(const double* xyz, size_t n, int32_t* out)
     }
 }
 
-double ClosestTriangleIndex::voxel() const { return mImpl->voxel; }
-size_t ClosestTriangleIndex::memoryBytes() const { return mImpl->memoryBytes; }
+double ClosestTriangleIndex::voxel() const {
+    return mImpl->voxel;
+}
+size_t ClosestTriangleIndex::memoryBytes() const {
+    return mImpl->memoryBytes;
+}
 
-} // namespace gale::fields
+} // namespace gale::geometry

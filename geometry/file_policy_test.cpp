@@ -1,7 +1,7 @@
 // Tests of the file policy for names in expressions: relative names inside the folder resolve,
 // `..` out of it, absolute paths and symbolic links leading out are refused unless the folder
 // is allowed (--allow-path); `#` sequences are found with their padding; frame picking.
-#include "fields/geometry_paths.h"
+#include "geometry/file_policy.h"
 
 #include <catch2/catch.hpp>
 
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <unistd.h>
 
-using namespace gale::fields;
+using namespace gale::geometry;
 namespace fs = std::filesystem;
 
 namespace {
@@ -30,7 +30,9 @@ struct TempTree {
         std::error_code ec;
         fs::remove_all(root, ec);
     }
-    void touch(const std::string& rel) const { std::ofstream((root / rel).string()) << "v 0 0 0\n"; }
+    void touch(const std::string& rel) const {
+        std::ofstream((root / rel).string()) << "v 0 0 0\n";
+    }
     std::string str(const std::string& rel) const { return (root / rel).string(); }
 };
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 struct FileAccess {
     std::string baseDir;              // names resolve against this folder ("": the current one)
@@ -41,8 +41,7 @@ struct FileRef {
 // Resolves and checks `name` under the policy, then finds its file (a plain name must be an
 // existing regular file) or its frames (a sequence needs at least one). False with `error` (a
 // sentence naming the file) otherwise. Every frame file is checked against the policy too.
-bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
-               std::string& error);
+bool findFiles(const FileAccess& access, const std::string& name, FileRef& out, std::string& error);
 
 // A file named by a scene key rather than an expression (a [[collider]] mesh): its canonical path
 // and cache key, without the policy. False with `error` when it is missing or a folder.
@@ -60,4 +59,4 @@ const FrameFile& nearestFrame(const FileRef& ref, double frame);
 // weight of b (0..1); both the first or the last one, weight 0, outside the range.
 void bracketFrames(const FileRef& ref, double frame, size_t& a, size_t& b, double& weight);
 
-} // namespace gale::fields
+} // namespace gale::geometry

@@ -1,9 +1,9 @@
 // The file policy of expressions that name files: resolution against the expression's folder,
 // containment (canonical paths, so symbolic links cannot lead out), --allow-path folders, `#`
 // frame sequences found by scanning their folder, and the per-file cache keys.
-#include "fields/geometry_paths.h"
+#include "geometry/file_policy.h"
 
-#include "fields/grid_sample.h"
+#include "io/grid.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,7 +12,7 @@
 #include <filesystem>
 #include <system_error>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 namespace fs = std::filesystem;
 
@@ -82,7 +82,9 @@ bool fileKey(const fs::path& canonical, std::string& key, std::string& error) {
     return true;
 }
 
-bool hasHashRun(const std::string& s) { return s.find('#') != std::string::npos; }
+bool hasHashRun(const std::string& s) {
+    return s.find('#') != std::string::npos;
+}
 
 } // namespace
 
@@ -130,7 +132,8 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
     const fs::path p(resolved);
     const std::string file = p.filename().string();
     if (hasHashRun(p.parent_path().string())) {
-        error = "'" + name + "': a '#' frame number may only appear in the file name, not in a "
+        error = "'" + name +
+                "': a '#' frame number may only appear in the file name, not in a "
                 "folder";
         return false;
     }
@@ -140,8 +143,7 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         // resolved) was already checked against the policy.
         const fs::file_status st = fs::status(p, ec);
         if (ec || !fs::exists(st)) {
-            error = "cannot read '" + name + "' (" + resolved + "): " +
-                    std::strerror(ENOENT);
+            error = "cannot read '" + name + "' (" + resolved + "): " + std::strerror(ENOENT);
             return false;
         }
         if (fs::is_directory(st)) {
@@ -275,4 +277,4 @@ void bracketFrames(const FileRef& ref, double frame, size_t& a, size_t& b, doubl
     }
 }
 
-} // namespace gale::fields
+} // namespace gale::geometry

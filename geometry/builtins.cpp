@@ -1,10 +1,10 @@
 // The geometry built-ins: sdf(), sdfgrad(), shadow(), vdb() and meshvel(). Their file names are
 // constant strings checked at compile time by validate hooks (path policy, loading, grid types:
 // errors at the argument's file:line:col); kernels then sample cached volumes per block.
-#include "fields/expression_field.h"
-#include "fields/geometry.h"
-#include "fields/geometry_cache.h"
-#include "fields/geometry_paths.h"
+#include "geometry/builtins.h"
+#include "geometry/cache.h"
+#include "geometry/file_policy.h"
+#include "geometry/geometry.h"
 
 #include <atomic>
 #include <cmath>
@@ -14,13 +14,13 @@
 #include <shared_mutex>
 #include <unordered_map>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 namespace {
 
+using runtime::kBlockSize;
 using runtime::KernelFrame;
 using runtime::Operand;
-using runtime::kBlockSize;
 
 // What the built-ins of one function table share: the file policy and the references their
 // validate hooks resolved (by name as written), read by the kernels.
@@ -233,20 +233,21 @@ io::IoError frameMotion(const FileRef& ref, size_t j, double voxel, int bandVoxe
                     e.file = ref.frames[j].path;
                     e.message = "the frames of '" + ref.name +
                                 "' do not share one mesh (vertex count or faces differ between "
-                                "frame " + std::to_string(ref.frames[j].frame) +
+                                "frame " +
+                                std::to_string(ref.frames[j].frame) +
                                 " and its neighbours); meshvel() needs the same mesh moving";
                     return e;
                 }
             }
-            const double span =
-                static_cast<double>(ref.frames[hi].frame - ref.frames[lo].frame);
+            const double span = static_cast<double>(ref.frames[hi].frame - ref.frames[lo].frame);
             m->velocity.assign(m->mesh->points.size(), {0.0f, 0.0f, 0.0f});
             if (span > 0.0)
                 for (size_t i = 0; i < m->velocity.size(); ++i)
                     for (int k = 0; k < 3; ++k)
                         m->velocity[i][static_cast<size_t>(k)] = static_cast<float>(
                             (static_cast<double>(b->points[i][static_cast<size_t>(k)]) -
-                             a->points[i][static_cast<size_t>(k)]) / span);
+                             a->points[i][static_cast<size_t>(k)]) /
+                            span);
             if (io::IoError e = cachedTriangleIndex(ref.frames[j], voxel, bandVoxels, m->index))
                 return e;
             bytes = m->velocity.size() * sizeof(m->velocity[0]);
@@ -303,8 +304,8 @@ struct MeshVelK {
                 ma->mesh->triangles != mb->mesh->triangles)
                 return fail(f, ctx, i0, count,
                             "the frames of '" + ref->name + "' do not share one mesh");
-            (w > 0.5 ? mb : ma)->index->candidates(xyz + 3 * i0, static_cast<size_t>(count),
-                                                  cand + 8 * i0);
+            (w > 0.5 ? mb : ma)
+                ->index->candidates(xyz + 3 * i0, static_cast<size_t>(count), cand + 8 * i0);
             const auto& tris = ma->mesh->triangles;
             for (int i = i0; i < i0 + count; ++i) {
                 const std::array<double, 3> p{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
@@ -320,8 +321,8 @@ struct MeshVelK {
                     const auto pc = lerp3(ma->mesh->points[tri[2]], mb->mesh->points[tri[2]], w);
                     std::array<double, 3> bw;
                     const auto q = closestPointOnTriangle(p, pa, pb, pc, bw);
-                    const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                                      (p[2] - q[2]) * (p[2] - q[2]);
+                    const double d2 = (p[0] - q[0]) * (p[0] - q[0]) +
+                                      (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
                     if (d2 < best) {
                         best = d2;
                         bestW = bw;
@@ -337,8 +338,10 @@ struct MeshVelK {
                 for (int k = 0; k < 3; ++k) {
                     double v = 0.0;
                     for (int c = 0; c < 3; ++c) {
-                        const double va = ma->velocity[tri[static_cast<size_t>(c)]][static_cast<size_t>(k)];
-                        const double vb = mb->velocity[tri[static_cast<size_t>(c)]][static_cast<size_t>(k)];
+                        const double va =
+                            ma->velocity[tri[static_cast<size_t>(c)]][static_cast<size_t>(k)];
+                        const double vb =
+                            mb->velocity[tri[static_cast<size_t>(c)]][static_cast<size_t>(k)];
                         v += bestW[static_cast<size_t>(c)] * (va + w * (vb - va));
                     }
                     f.outComp(k)[i] = static_cast<T>(v * fps * fade);
@@ -422,8 +425,12 @@ bool validateMeshSdf(lang::CallSite& site, size_t voxelArg) {
     return true;
 }
 
-bool validateSdf(lang::CallSite& site) { return validateMeshSdf(site, 2); }
-bool validateShadow(lang::CallSite& site) { return validateMeshSdf(site, 4); }
+bool validateSdf(lang::CallSite& site) {
+    return validateMeshSdf(site, 2);
+}
+bool validateShadow(lang::CallSite& site) {
+    return validateMeshSdf(site, 4);
+}
 
 bool validateVdb(lang::CallSite& site) {
     const std::string* name = constantString(site, 0, "file", "\"wind.vdb\"");
@@ -463,7 +470,8 @@ bool validateMeshVel(lang::CallSite& site) {
     if (!ref->sequence) {
         site.sink->error(site.argSpans[0],
                          "meshvel() needs a per-frame mesh sequence with a '#' for the frame "
-                         "number (\"body.#.obj\"); '" + *name + "' is one mesh, which does not move");
+                         "number (\"body.#.obj\"); '" +
+                             *name + "' is one mesh, which does not move");
         return false;
     }
     std::shared_ptr<const TriangleMesh> mesh;
@@ -528,8 +536,4 @@ withFileAccess(const std::shared_ptr<const runtime::FunctionTable>& table,
     return copy;
 }
 
-std::shared_ptr<const runtime::FunctionTable> fieldFunctions(const FileAccess& access) {
-    return withFileAccess(fieldFunctions(), access);
-}
-
-} // namespace gale::fields
+} // namespace gale::geometry

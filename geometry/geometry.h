@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 // A triangle soup with shared vertices (float positions, what OpenVDB consumes).
 struct TriangleMesh {
@@ -156,4 +156,4 @@ private:
 // VelocityVolume::load.
 io::IoError checkVdbGrid(const std::string& path, const std::string& gridName);
 
-} // namespace gale::fields
+} // namespace gale::geometry

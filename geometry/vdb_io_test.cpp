@@ -1,7 +1,7 @@
 // Tests for the .vdb velocity files: a written grid read back has the same values, voxel size,
 // origin, name, vector type and box (uniform regions included); errors for missing files,
 // missing grids and wrong value counts.
-#include "fields/vdb_io.h"
+#include "geometry/vdb_io.h"
 #include "io/test_support.h"
 
 #include <catch2/catch.hpp>
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <unistd.h>
 
-using namespace gale::fields;
+using namespace gale::geometry;
 using namespace gale::io;
 
 namespace {

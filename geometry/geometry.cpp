@@ -1,14 +1,14 @@
 // Triangle meshes for the geometry fields (no OpenVDB here): reading OBJ/PLY with polygons fanned
 // into triangles, generated spheres and boxes, OBJ writing, the closest point on a triangle and
 // the automatic narrow-band width.
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 
 #include "io/atomic_file.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 namespace {
 
@@ -79,8 +79,7 @@ io::IoError readTriangleMesh(const std::string& path, TriangleMesh& out) {
     return {};
 }
 
-TriangleMesh uvSphereMesh(const std::array<double, 3>& c, double radius, int rings,
-                          int segments) {
+TriangleMesh uvSphereMesh(const std::array<double, 3>& c, double radius, int rings, int segments) {
     rings = std::max(rings, 2);
     segments = std::max(segments, 3);
     const double pi = 3.14159265358979323846;
@@ -200,4 +199,4 @@ int automaticBandVoxels(const TriangleMesh& mesh, double voxel) {
     return static_cast<int>(std::clamp(v, 3.0, 64.0));
 }
 
-} // namespace gale::fields
+} // namespace gale::geometry

@@ -2,8 +2,8 @@
 // within one voxel of the analytic distance, unit gradients along the analytic normal, the wind
 // shadow's bounds and monotonicity behind a sphere, closest points on triangles, mesh reading
 // (polygons fanned, errors) and the cache's once-per-key rule.
-#include "fields/geometry.h"
-#include "fields/geometry_cache.h"
+#include "geometry/cache.h"
+#include "geometry/geometry.h"
 #include "io/test_support.h"
 
 #include <catch2/catch.hpp>
@@ -17,7 +17,7 @@
 #include <thread>
 #include <unistd.h>
 
-using namespace gale::fields;
+using namespace gale::geometry;
 using namespace gale::io;
 
 namespace {
@@ -163,9 +163,9 @@ TEST_CASE("shadow: 0 inside and just behind a sphere, rising monotonically to 1 
         sdf->shadow(p, dir, &L, 1, &s);
         return s;
     };
-    CHECK(shadowAt(0, 0, 0) == Approx(0.0).margin(1e-12));  // inside
-    CHECK(shadowAt(-1.0, 0, 0) == Approx(1.0).margin(1e-12)); // upwind, free air
-    CHECK(shadowAt(1.0, 0.6, 0) == Approx(1.0).margin(1e-12)); // beside the shadow
+    CHECK(shadowAt(0, 0, 0) == Approx(0.0).margin(1e-12));                 // inside
+    CHECK(shadowAt(-1.0, 0, 0) == Approx(1.0).margin(1e-12));              // upwind, free air
+    CHECK(shadowAt(1.0, 0.6, 0) == Approx(1.0).margin(1e-12));             // beside the shadow
     CHECK(shadowAt(r + L + 2 * voxel, 0, 0) == Approx(1.0).margin(1e-12)); // beyond `length`
     // On the axis behind the sphere the ray enters the body at s = x - r, so the shadow lies
     // between the smoothstep evaluated one soft-edge width (plus interpolation) either side.
@@ -214,11 +214,10 @@ TEST_CASE("closest point on a triangle: face, edge and vertex regions", "[geomet
     CHECK(w[1] == 1.0);
 }
 
-TEST_CASE("meshes: OBJ quads and PLY faces are fanned into triangles; clear errors",
-          "[geometry]") {
+TEST_CASE("meshes: OBJ quads and PLY faces are fanned into triangles; clear errors", "[geometry]") {
     TempDir dir;
     writeText(dir.file("quad.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
-                                     "f 1 2 3 4\nf 1 2 5\n");
+                                    "f 1 2 3 4\nf 1 2 5\n");
     TriangleMesh m;
     IoError e = readTriangleMesh(dir.file("quad.obj"), m);
     INFO(e.render());
@@ -229,9 +228,9 @@ TEST_CASE("meshes: OBJ quads and PLY faces are fanned into triangles; clear erro
     CHECK(m.bounds() == std::array<double, 6>{0, 0, 0, 1, 1, 1});
 
     writeText(dir.file("tri.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                    "property float y\nproperty float z\nelement face 1\n"
-                                    "property list uchar int vertex_indices\nend_header\n"
-                                    "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+                                   "property float y\nproperty float z\nelement face 1\n"
+                                   "property list uchar int vertex_indices\nend_header\n"
+                                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     REQUIRE_FALSE(readTriangleMesh(dir.file("tri.ply"), m));
     CHECK(m.triangles.size() == 1);
 
@@ -267,8 +266,7 @@ TEST_CASE("SDF build errors: empty meshes, bad voxels, too many voxels", "[geome
     CHECK(e.message.find("larger voxel") != std::string::npos);
 }
 
-TEST_CASE("the geometry cache builds each key once, even when asked concurrently",
-          "[geometry]") {
+TEST_CASE("the geometry cache builds each key once, even when asked concurrently", "[geometry]") {
     GeometryCache cache(1000);
     std::atomic<int> calls{0};
     auto build = [&](std::shared_ptr<const int>& v, size_t& bytes) -> IoError {

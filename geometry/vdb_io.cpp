@@ -1,9 +1,9 @@
 // OpenVDB reading and writing of velocity grids, and the VelocityVolume behind vdb(). One of
 // the two files that include OpenVDB headers (they are slow to compile; vdb_geometry.cpp is the
-// other); everything else goes through fields/vdb_io.h and fields/geometry.h.
-#include "fields/vdb_io.h"
+// other); everything else goes through geometry/vdb_io.h and geometry/geometry.h.
+#include "geometry/vdb_io.h"
 
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
@@ -19,7 +19,7 @@
 #include <fstream>
 #include <stdexcept>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 namespace {
 
@@ -252,9 +252,9 @@ bool isVectorGrid(const openvdb::GridBase& g) {
 std::string gridList(const openvdb::GridPtrVec& grids) {
     std::string out;
     for (const openvdb::GridBase::Ptr& g : grids)
-        out += (out.empty() ? "" : ", ") + (g->getName().empty() ? std::string("<unnamed>")
-                                                                   : g->getName()) +
-               " (" + g->valueType() + ")";
+        out += (out.empty() ? "" : ", ") +
+               (g->getName().empty() ? std::string("<unnamed>") : g->getName()) + " (" +
+               g->valueType() + ")";
     return out.empty() ? std::string("none") : out;
 }
 
@@ -349,8 +349,9 @@ void VelocityVolume::sample(const double* xyz, size_t n, VolumeInterp interp, do
         // A position within float rounding of a voxel centre reads that voxel exactly, so a
         // grid written by `gale sample` reads back bit for bit at its cell centres even from
         // float positions (a float keeps 24 bits: 6e-8 relative).
-        const double tol = 1.2e-7 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2])) / minVoxel +
-                           1e-9 * (1.0 + std::abs(index[0]) + std::abs(index[1]) + std::abs(index[2]));
+        const double tol =
+            1.2e-7 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2])) / minVoxel +
+            1e-9 * (1.0 + std::abs(index[0]) + std::abs(index[1]) + std::abs(index[2]));
         for (int a = 0; a < 3; ++a) {
             const double r = std::round(index[a]);
             if (std::abs(index[a] - r) <= tol) index[a] = r;
@@ -371,7 +372,11 @@ void VelocityVolume::sample(const double* xyz, size_t n, VolumeInterp interp, do
     }
 }
 
-const std::string& VelocityVolume::gridName() const { return mImpl->name; }
-size_t VelocityVolume::memoryBytes() const { return mImpl->memoryBytes; }
+const std::string& VelocityVolume::gridName() const {
+    return mImpl->name;
+}
+size_t VelocityVolume::memoryBytes() const {
+    return mImpl->memoryBytes;
+}
 
-} // namespace gale::fields
+} // namespace gale::geometry

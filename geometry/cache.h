@@ -3,8 +3,8 @@
 // first caller builds outside the lock, later callers of the same key wait for it.
 #pragma once
 
-#include "fields/geometry.h"
-#include "fields/geometry_paths.h"
+#include "geometry/file_policy.h"
+#include "geometry/geometry.h"
 #include "io/pointset.h"
 
 #include <cstddef>
@@ -15,7 +15,7 @@
 #include <string>
 #include <unordered_map>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 class GeometryCache {
 public:
@@ -53,9 +53,9 @@ public:
 
     void setBudget(size_t bytes);
     size_t budget() const;
-    size_t bytes() const;   // sizes of the entries held
+    size_t bytes() const; // sizes of the entries held
     size_t entries() const;
-    size_t builds() const;  // builder calls so far (for tests of the once-per-key rule)
+    size_t builds() const; // builder calls so far (for tests of the once-per-key rule)
     void clear();
 
 private:
@@ -80,4 +80,4 @@ io::IoError cachedVelocity(const FrameFile& file, const std::string& gridName,
 io::IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVoxels,
                                 std::shared_ptr<const ClosestTriangleIndex>& out);
 
-} // namespace gale::fields
+} // namespace gale::geometry

@@ -1,17 +1,17 @@
 // OpenVDB files for velocity grids: write a dense, cell-centred Vec3s grid (named `vel`,
 // contravariant-relative, the Houdini/Blender convention) and read one back as a dense box.
 // vdb_io.cpp and vdb_geometry.cpp are the only translation units that include OpenVDB headers
-// (they are slow to compile); sampling a .vdb as a field is VelocityVolume in fields/geometry.h.
+// (they are slow to compile); sampling a .vdb as a field is VelocityVolume in geometry/geometry.h.
 #pragma once
 
-#include "fields/grid_sample.h"
+#include "io/grid.h"
 #include "io/pointset.h"
 
 #include <map>
 #include <string>
 #include <vector>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 // What to store besides the voxels.
 struct VdbWriteOptions {
@@ -49,4 +49,4 @@ struct VdbVelocity {
 // missing, is not Vec3s, has a non-linear or rotated transform, or is empty.
 io::IoError readVdbVelocity(const std::string& path, const std::string& gridName, VdbVelocity& out);
 
-} // namespace gale::fields
+} // namespace gale::geometry

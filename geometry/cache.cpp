@@ -1,13 +1,13 @@
 // The geometry cache: a map of keys to shared futures (so one builder per key, built outside
 // the lock) with an LRU list bounded by a byte budget.
-#include "fields/geometry_cache.h"
+#include "geometry/cache.h"
 
 #include <charconv>
 #include <cstdlib>
 #include <exception>
 #include <future>
 
-namespace gale::fields {
+namespace gale::geometry {
 
 struct GeometryCache::Entry {
     std::shared_future<Built> future;
@@ -200,4 +200,4 @@ io::IoError cachedTriangleIndex(const FrameFile& file, double voxel, int bandVox
         out);
 }
 
-} // namespace gale::fields
+} // namespace gale::geometry
