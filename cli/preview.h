@@ -6,7 +6,7 @@
 
 #include "cli/commands.h"
 #include "cli/field_input.h"
-#include "cli/render.h"
+#include "viz/render.h"
 #include "fields/scene.h"
 
 #include <string>

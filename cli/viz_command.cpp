@@ -4,7 +4,7 @@
 #include "cli/common.h"
 #include "cli/field_input.h"
 #include "cli/preview.h"
-#include "cli/render.h"
+#include "viz/render.h"
 #include "fields/grid_sample.h"
 #include "fields/rigs.h"
 

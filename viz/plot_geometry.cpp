@@ -1,5 +1,5 @@
 // The drawing-library-free parts of `gale viz` pictures: viridis, ticks, streamline tracing.
-#include "cli/plot_geometry.h"
+#include "viz/plot_geometry.h"
 
 #include <algorithm>
 #include <cmath>

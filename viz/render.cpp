@@ -1,9 +1,9 @@
 // cairo drawing of `gale viz` pictures: speed raster (viridis), colour bar with m/s ticks,
 // axes, arrows or RK2 streamlines, windicator inset, gust bands and the gust timeline; PNG
 // via an image surface, SVG via an SVG surface, both written atomically.
-#include "cli/render.h"
+#include "viz/render.h"
 
-#include "cli/plot_geometry.h"
+#include "viz/plot_geometry.h"
 #include "fields/grid_sample.h"
 
 #include <cairo-svg.h>
