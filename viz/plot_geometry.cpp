@@ -1,11 +1,11 @@
-// The drawing-library-free parts of `gale viz` pictures: viridis, ticks, streamline tracing.
+// The drawing-library-free parts of viz pictures: viridis, ticks, streamline tracing.
 #include "viz/plot_geometry.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-namespace gale::cli {
+namespace gale::viz {
 
 // matplotlib's viridis (CC0), every 8th of its 256 entries and the last.
 namespace {
@@ -141,4 +141,4 @@ std::vector<Polyline> traceStreamlines(const DirectionFn& direction, double widt
     return lines;
 }
 
-} // namespace gale::cli
+} // namespace gale::viz

@@ -1,4 +1,4 @@
-// The drawing-library-free parts of `gale viz` pictures: the viridis colour map, round tick
+// The drawing-library-free parts of viz pictures: the viridis colour map, round tick
 // values and their labels, and evenly spaced streamlines traced through a direction field.
 #pragma once
 
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace gale::cli {
+namespace gale::viz {
 
 struct Rgb {
     double r, g, b;
@@ -38,4 +38,4 @@ using DirectionFn = std::function<bool(double x, double y, double& dx, double& d
 std::vector<Polyline> traceStreamlines(const DirectionFn& direction, double width, double height,
                                        double separation, double step);
 
-} // namespace gale::cli
+} // namespace gale::viz

@@ -1,15 +1,14 @@
-// Drawing `gale viz` pictures (cairo, PNG or SVG): a slice of a wind field coloured by speed
-// (viridis) with a legend and scale, arrows or streamlines for the in-plane direction, the
-// windicator arrow, gust fronts and a gust timeline. Only render.cpp includes cairo.
+// What a viz picture shows, as plain data: a slice of a wind field (sampled velocities), the
+// rigs over it (windicator arrow, gust fronts, gust timeline), simulated cloth and hair, the
+// layout of the parts, and contact sheets of thumbnails. Drawing them is a backend's work
+// (cairo_render.h: PNG and SVG); a browser page could draw the same data.
 #pragma once
-
-#include "io/pointset.h"
 
 #include <array>
 #include <string>
 #include <vector>
 
-namespace gale::cli {
+namespace gale::viz {
 
 enum class ImageFormat { Png, Svg };
 // From the extension (.png, .svg, any case); false for anything else.
@@ -104,10 +103,6 @@ struct RenderSettings {
     bool compact = false;      // a thumbnail: the plot only (no title, axes, legend, rigs)
 };
 
-// Draws the picture and writes it to `path` through a temporary file and a rename.
-io::IoError renderSlice(const std::string& path, const SliceLayout& layout, const Slice& slice,
-                        const SliceOverlays& overlays, const RenderSettings& settings);
-
 // One thumbnail of a contact sheet: a picture laid out for the cell (layoutThumbnail).
 struct ContactCell {
     Slice slice;
@@ -128,6 +123,5 @@ struct ContactSheet {
     int labelW = 220;
     std::vector<std::vector<ContactCell>> rows;      // rows[r][c]
 };
-io::IoError renderContactSheet(const std::string& path, const ContactSheet& sheet);
 
-} // namespace gale::cli
+} // namespace gale::viz
