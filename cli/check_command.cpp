@@ -6,6 +6,7 @@
 #include "cli/field_input.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "scene/load.h"
 
 #include <CLI/CLI.hpp>
 
@@ -23,9 +24,9 @@ int checkScene(const std::string& path, const std::vector<std::string>& sets,
                const std::vector<std::string>& allowPaths) {
     fields::Scene scene;
     std::vector<fields::SceneError> errors;
-    fields::SceneLoadOptions options;
+    gale::scene::SceneLoadOptions options;
     options.sets = sets;
-    if (!fields::loadScene(path, scene, errors, options)) {
+    if (!gale::scene::loadScene(path, scene, errors, options)) {
         bool io = false;
         for (const fields::SceneError& e : errors) {
             std::cerr << e.render() << '\n';

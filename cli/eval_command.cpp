@@ -7,6 +7,7 @@
 #include "fields/expression_field.h"
 #include "fields/scene.h"
 #include "io/atomic_file.h"
+#include "scene/load.h"
 
 #include <CLI/CLI.hpp>
 
@@ -301,9 +302,9 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints, io::Point
     }
     fields::Scene scene;
     std::vector<fields::SceneError> errors;
-    fields::SceneLoadOptions options;
+    gale::scene::SceneLoadOptions options;
     options.sets = o.source.sets;
-    if (!fields::loadScene(o.source.file, scene, errors, options))
+    if (!gale::scene::loadScene(o.source.file, scene, errors, options))
         return reportSceneErrors(errors);
     const bool asFloat = o.precision != "double";
     std::string report;

@@ -6,6 +6,7 @@
 #include "cli/common.h"
 #include "cli/wedge.h"
 #include "fields/grid_sample.h"
+#include "scene/load.h"
 #include "solver/scene.h"
 #include "viz/cairo_render.h"
 
@@ -262,7 +263,7 @@ int runVizFrames(const VizOptions& o) {
     if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
     solver::SimScene sim;
     std::vector<fields::SceneError> errors;
-    if (!solver::loadSimScene(o.source.file, sim, errors, o.source.sets)) {
+    if (!gale::scene::loadSimScene(o.source.file, sim, errors, o.source.sets)) {
         for (const fields::SceneError& e : errors) std::cerr << e.render() << '\n';
         return kExitInput;
     }

@@ -212,33 +212,3 @@ TEST_CASE("geometry diagnostics point at the argument and name the file",
     // A uniform voxel (a parameter) is fine: the volume is built at evaluation.
     CHECK(shot("$res = 0.05;\nsdf(\"box.obj\", $P, $res)").empty());
 }
-
-TEST_CASE("a scene's expressions name files relative to their own file, inside the scene's "
-          "folder",
-          "[geometry][builtins]") {
-    TempDir dir;
-    fs::create_directories(dir.path / "wind");
-    REQUIRE_FALSE(writeTriangleMeshObj(dir.file("body.obj"), uvSphereMesh({0, 0, 0}, 0.5, 16, 32)));
-    std::ofstream(dir.file("wind/around.se")) << "[sdf(\"../body.obj\", $P), 0, 0]\n";
-    std::ofstream(dir.file("scene.toml"))
-        << "[[field]]\nname = \"a\"\nexpr = \"wind/around.se\"\n"
-           "[[field]]\nname = \"b\"\nsource = 'sdf(\"body.obj\", $P) * [0, 1, 0]'\n";
-    Scene scene;
-    std::vector<SceneError> errors;
-    REQUIRE(loadScene(dir.file("scene.toml"), scene, errors));
-    std::string report;
-    FieldPtr f = buildSceneField(scene, gale::runtime::Precision::Double, report);
-    INFO(report);
-    REQUIRE(f);
-    const std::vector<double> v = sampleAt(*f, {1.0, 0, 0});
-    CHECK(v[0] == Approx(0.5).margin(0.02));
-    CHECK(v[1] == Approx(0.5).margin(0.02));
-
-    // An inline source that leaves the scene's folder: an error at its line and column.
-    std::ofstream(dir.file("bad.toml"))
-        << "[[field]]\nname = \"a\"\nsource = 'sdf(\"../x.obj\", $P)'\n";
-    REQUIRE(loadScene(dir.file("bad.toml"), scene, errors));
-    report.clear();
-    CHECK_FALSE(buildSceneField(scene, gale::runtime::Precision::Double, report));
-    CHECK(report.find("bad.toml:3:15: error: '../x.obj' leads outside") != std::string::npos);
-}

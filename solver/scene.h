@@ -1,6 +1,6 @@
-// The solver's part of a scene file — [[cloth]], [[hair]], [[collider]] and [solver] — read
-// with toml++ beside fields::loadScene's wind part (one file, one set of --set overrides), and
-// turned into bodies: meshes and strands loaded, painted maps evaluated, pins resolved.
+// The solver's part of a scene — [[cloth]], [[hair]], [[collider]] and [solver] — as the scene
+// loader (scene/load.h) reads it from the same TOML file as the wind, and turned into bodies
+// here: meshes and strands loaded, painted maps evaluated, pins resolved.
 #pragma once
 
 #include "fields/scene.h"
@@ -83,13 +83,6 @@ struct SimScene {
     std::vector<HairSpec> hairs;
     std::vector<Collider> colliders;
 };
-
-// Reads the whole scene: the wind part through fields::loadScene, the solver's sections here.
-// `sets` are `--set KEY=VALUE` overrides by dotted path (`cloth.cape.drag=0.8`,
-// `collider.0.radius=0.4`, `solver.max_halvings=4`, and the wind's own paths). Every problem
-// is reported at file:line:col; false when there were errors.
-bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
-                  const std::vector<std::string>& sets = {});
 
 // Loads meshes and strands, evaluates painted maps and pins, and makes the bodies. Problems
 // (a missing mesh, an unknown map, an expression error) come back as errors at the place in

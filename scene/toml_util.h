@@ -1,5 +1,5 @@
-// Small pieces shared by the two TOML scene loaders — the wind's (fields/scene_toml.cpp) and the
-// solver's (solver/scene_toml.cpp): text helpers, names of TOML types, "did you mean", and how a
+// Small pieces shared by the scene loader's sections — the wind's (scene/wind_sections.cpp) and
+// the bodies' (scene/body_sections.cpp): text helpers, names of TOML types, "did you mean", and how a
 // `--set KEY=VALUE` override's value is read.
 #pragma once
 
@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-namespace gale::fields {
+namespace gale::scene {
 
 // `s` without leading and trailing blanks.
 std::string trimText(std::string_view s);
@@ -36,4 +36,4 @@ std::optional<toml::table> parseSetValue(const std::string& text, const std::str
 bool assignAtPath(toml::table& target, const std::vector<std::string>& parts, size_t first, std::string& where,
                   toml::node&& value, std::string& error);
 
-} // namespace gale::fields
+} // namespace gale::scene

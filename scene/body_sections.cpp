@@ -1,10 +1,10 @@
-// Reading [[cloth]], [[hair]], [[collider]] and [solver] with toml++ (the only solver file that
-// includes it: it is slow to compile). --set overrides are applied to the TOML tree by dotted
+// The scene loader's body sections: [[cloth]], [[hair]], [[collider]] and [solver], read with
+// toml++ after the wind sections (loadSimScene). --set overrides are applied to the TOML tree by dotted
 // path first; then every key is checked and converted, every problem reported at file:line:col.
-#include "solver/scene.h"
+#include "scene/load.h"
+#include "scene/toml_util.h"
 #include "solver/mesh_collider.h"
-
-#include "fields/scene_toml_util.h"
+#include "solver/scene.h"
 
 #include "lang/functions.h"
 
@@ -18,16 +18,9 @@
 #include <set>
 #include <sstream>
 
-namespace gale::solver {
+namespace gale::scene {
 
-using fields::assignAtPath;
-using fields::didYouMean;
-using fields::isTomlNumber;
-using fields::joinNames;
-using fields::parseSetValue;
-using fields::splitText;
-using fields::tomlTypeName;
-using fields::trimText;
+using namespace gale::solver;
 
 namespace {
 
@@ -781,11 +774,11 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
 bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
                   const std::vector<std::string>& sets) {
     out = SimScene{};
-    fields::SceneLoadOptions options;
+    SceneLoadOptions options;
     options.sets = sets;
     options.foreignSections = {"cloth", "hair", "collider", "solver"};
     const size_t before = errors.size();
-    const bool windOk = fields::loadScene(path, out.wind, errors, options);
+    const bool windOk = loadScene(path, out.wind, errors, options);
     std::ifstream in(path, std::ios::binary);
     if (!in) return false; // loadScene reported it
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -804,4 +797,4 @@ bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::Sc
     return windOk && errors.size() == mine;
 }
 
-} // namespace gale::solver
+} // namespace gale::scene

@@ -1,6 +1,7 @@
 // Scene files: the solver's sections read with their units and defaults, unknown keys and bad
 // values reported at file:line:col, --set overrides by dotted path, painted maps from
 // expressions, pins by box, and bodies built from grids and strand grids.
+#include "scene/load.h"
 #include "solver/scene.h"
 
 #include <catch2/catch.hpp>
@@ -10,6 +11,7 @@
 #include <unistd.h>
 
 using namespace gale::solver;
+using namespace gale::scene;
 
 namespace {
 

@@ -1,11 +1,13 @@
-// Loading the wind part of a scene file with toml++ (the only file that includes it: it is slow
-// to compile): --set overrides applied to the TOML tree by dotted path, then every key checked
+// The scene loader's wind sections ([scene], [windicator], [[gust]], [[field]]) and the reading
+// of a scene file with toml++ (only scene/ includes it: it is slow to compile): --set overrides applied to the TOML tree by dotted path, then every key checked
 // and converted, with every problem reported at its file:line:col.
+#include "scene/load.h"
+
 #include "fields/expression_field.h"
 #include "fields/presets.h"
 #include "fields/scene.h"
-#include "fields/scene_toml_util.h"
 #include "io/pointset.h"
+#include "scene/toml_util.h"
 #include "lang/functions.h"
 
 #include <toml++/toml.h>
@@ -21,7 +23,9 @@
 #include <set>
 #include <sstream>
 
-namespace gale::fields {
+namespace gale::scene {
+
+using namespace gale::fields;
 
 namespace {
 
@@ -787,4 +791,4 @@ bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& err
     return errors.size() == errorsBefore;
 }
 
-} // namespace gale::fields
+} // namespace gale::scene

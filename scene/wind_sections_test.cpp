@@ -3,6 +3,7 @@
 // with "did you mean"); then the scene's summed field built and sampled.
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "scene/load.h"
 #include "io/test_support.h"
 
 #include <catch2/catch.hpp>
@@ -14,6 +15,7 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::scene;
 
 namespace {
 

@@ -1,11 +1,11 @@
 // Helpers of the TOML scene loaders (see scene_toml_util.h).
-#include "fields/scene_toml_util.h"
+#include "scene/toml_util.h"
 
 #include "lang/functions.h"
 
 #include <sstream>
 
-namespace gale::fields {
+namespace gale::scene {
 
 std::string trimText(std::string_view s) {
     const size_t a = s.find_first_not_of(" \t\r\n"), b = s.find_last_not_of(" \t\r\n");
@@ -87,4 +87,4 @@ bool assignAtPath(toml::table& target, const std::vector<std::string>& parts, si
     return true;
 }
 
-} // namespace gale::fields
+} // namespace gale::scene
