@@ -2,6 +2,7 @@
 // toml++ after the wind sections (loadSimScene). --set overrides are applied to the TOML tree by dotted
 // path first; then every key is checked and converted, every problem reported at file:line:col.
 #include "scene/load.h"
+#include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "solver/mesh_collider.h"
 #include "solver/scene.h"
@@ -24,7 +25,6 @@ using namespace gale::solver;
 
 namespace {
 
-constexpr std::string_view kSetPrefix = "--set ";
 // Generated cloth and hair grids: at most this many vertices (a million already takes the
 // implicit solver minutes a frame and gigabytes).
 constexpr long long kMaxGridVertices = 1LL << 20;
@@ -46,60 +46,17 @@ const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radiu
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
 
-class Loader {
+class Loader : public TomlReader {
 public:
     Loader(std::string path, const std::string& text, std::vector<fields::SceneError>& errors)
-        : mPath(std::move(path)), mText(text), mErrors(errors) {
-        size_t start = 0;
-        while (true) {
-            mLineStarts.push_back(start);
-            const size_t nl = text.find('\n', start);
-            if (nl == std::string::npos) break;
-            start = nl + 1;
-        }
-    }
+        : TomlReader(std::move(path), text, errors) {}
 
     void applySets(toml::table& root, const std::vector<std::string>& sets);
     void load(const toml::table& root, const std::string& baseDir, SimScene& out);
 
 private:
-    fields::SceneError& error(const toml::source_region& where, std::string message) {
-        fields::SceneError e;
-        e.message = std::move(message);
-        if (where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
-            e.file = *where.path;
-        } else {
-            e.file = mPath;
-            e.line = static_cast<int>(where.begin.line);
-            e.col = static_cast<int>(where.begin.column);
-            e.sourceLine = lineText(e.line);
-        }
-        mErrors.push_back(std::move(e));
-        return mErrors.back();
-    }
-    fields::SceneError& error(const toml::node& at, std::string message) {
-        return error(at.source(), std::move(message));
-    }
-    fields::SceneError& setError(const std::string& set, std::string message) {
-        fields::SceneError e;
-        e.file = std::string(kSetPrefix) + set;
-        e.message = std::move(message);
-        mErrors.push_back(std::move(e));
-        return mErrors.back();
-    }
-    std::string lineText(int line) const {
-        if (line <= 0 || static_cast<size_t>(line) > mLineStarts.size()) return {};
-        const size_t a = mLineStarts[static_cast<size_t>(line - 1)];
-        size_t b = mText.find('\n', a);
-        if (b == std::string::npos) b = mText.size();
-        if (b > a && mText[b - 1] == '\r') --b;
-        return mText.substr(a, b - a);
-    }
-
-    void checkKeys(const toml::table& t, const std::vector<std::string>& allowed, const std::string& section);
     bool number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin);
     bool integer(const toml::node& n, const std::string& what, long long& out, long long min);
-    bool string(const toml::node& n, const std::string& what, std::string& out);
     bool choice(const toml::node& n, const std::string& what, const std::vector<std::string>& options,
                 std::string& out);
     bool boolean(const toml::node& n, const std::string& what, bool& out);
@@ -115,95 +72,20 @@ private:
     void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
     void loadCollider(const toml::table& t, size_t index, Collider& c);
     void loadSolver(const toml::table& t, SolverSection& s);
-
-    std::string mPath;
-    const std::string& mText;
-    std::vector<size_t> mLineStarts;
-    std::vector<fields::SceneError>& mErrors;
 };
+
 
 // ---- --set ------------------------------------------------------------------------------------
 
 void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) {
-    for (const std::string& set : sets) {
-        const size_t eq = set.find('=');
-        if (eq == std::string::npos) continue; // the wind loader reports the malformed ones
-        const std::string key = trimText(set.substr(0, eq));
-        const std::string text = trimText(set.substr(eq + 1));
-        const std::vector<std::string> parts = splitText(key, '.');
-        if (parts.empty() || text.empty() ||
-            std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); }))
-            continue;
-        const std::string& head = parts[0];
-        if (head != "cloth" && head != "hair" && head != "collider" && head != "solver") continue;
-
-        // The value as TOML, else a comma list of numbers, else a bare string (set_value.h).
-        std::optional<toml::table> parsed = parseSetValue(text, std::string(kSetPrefix) + set);
-        if (!parsed) {
-            setError(set, "cannot read the value '" + text + "'");
-            continue;
-        }
-        toml::table doc = std::move(*parsed);
-        toml::table* target = nullptr;
-        size_t next = 1;
-        std::string where = head;
-        if (head == "solver") {
-            if (!root.contains("solver")) root.insert("solver", toml::table{});
-            target = root.get("solver")->as_table();
-            if (!target) {
-                setError(set, "'solver' in the scene is not a table");
-                continue;
-            }
-        } else {
-            if (parts.size() < 3) {
-                setError(set, "expected " + head + ".NAME.KEY (or " + head + ".INDEX.KEY, from 0)");
-                continue;
-            }
-            toml::array* list = root.get(head) ? root.get(head)->as_array() : nullptr;
-            std::vector<std::string> names;
-            if (list)
-                for (size_t i = 0; i < list->size(); ++i) {
-                    toml::table* t = list->get(i)->as_table();
-                    if (!t) continue;
-                    std::string name = t->get("name") && t->get("name")->is_string()
-                                           ? t->get("name")->value<std::string>().value_or("")
-                                           : head + std::to_string(i);
-                    names.push_back(name);
-                    if (!target && (name == parts[1] || parts[1] == std::to_string(i))) target = t;
-                }
-            if (!target) {
-                fields::SceneError& e = setError(set, "the scene has no [[" + head + "]] named '" + parts[1] + "'");
-                const std::string hint = didYouMean(parts[1], names);
-                if (!hint.empty()) e.notes.push_back(hint);
-                const size_t count = list ? list->size() : 0;
-                e.notes.push_back("it has " + std::to_string(count) + " [[" + head + "]] entr" +
-                                  (count == 1 ? "y" : "ies") +
-                                  (names.empty() ? std::string() : " (" + joinNames(names) + ")") +
-                                  "; name one, or give its index from 0");
-                continue;
-            }
-            next = 2;
-            where = head + "." + parts[1];
-        }
-        std::string problem;
-        if (!assignAtPath(*target, parts, next, where, std::move(*doc.get("v")), problem)) setError(set, problem);
-    }
+    SetSections sections;
+    sections.tables = {"solver"};
+    sections.lists = {"cloth", "hair", "collider"};
+    sections.reportOthers = false; // the wind's loader reports malformed sets and unknown heads
+    TomlReader::applySets(root, sets, sections);
 }
 
 // ---- values -----------------------------------------------------------------------------------
-
-void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
-                       const std::string& section) {
-    for (auto&& [key, node] : t) {
-        const std::string name(key.str());
-        if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-        fields::SceneError& e = error(key.source().begin.line ? key.source() : node.source(),
-                                      "unknown key '" + name + "' in " + section);
-        const std::string hint = didYouMean(name, allowed);
-        if (!hint.empty()) e.notes.push_back(hint);
-        e.notes.push_back(section + " keys: " + joinNames(allowed));
-    }
-}
 
 bool Loader::number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin) {
     if (!isTomlNumber(n)) {
@@ -241,15 +123,6 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
         return false;
     }
     out = v;
-    return true;
-}
-
-bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
-    if (!n.is_string()) {
-        error(n, what + " must be a string, not " + tomlTypeName(n));
-        return false;
-    }
-    out = n.value<std::string>().value_or("");
     return true;
 }
 

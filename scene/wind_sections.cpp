@@ -7,6 +7,7 @@
 #include "fields/presets.h"
 #include "fields/scene.h"
 #include "io/pointset.h"
+#include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "lang/functions.h"
 
@@ -29,77 +30,18 @@ using namespace gale::fields;
 
 namespace {
 
-constexpr std::string_view kSetPrefix = "--set ";
-
-class Loader {
+class Loader : public TomlReader {
 public:
     Loader(const std::string& path, const std::string& text, std::vector<SceneError>& errors,
            const SceneLoadOptions& options)
-        : mPath(path), mText(text), mErrors(errors), mOptions(options) {
-        size_t start = 0;
-        for (;;) {
-            mLineStarts.push_back(start);
-            size_t nl = text.find('\n', start);
-            if (nl == std::string::npos) break;
-            start = nl + 1;
-        }
-    }
+        : TomlReader(path, text, errors), mOptions(options) {}
 
     void applySets(toml::table& root);
     void load(const toml::table& root, Scene& out);
 
-    // ---- error reporting ----
-    SceneError& error(const toml::source_region& where, std::string message) {
-        SceneError e;
-        e.message = std::move(message);
-        if (where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
-            e.file = *where.path;
-        } else {
-            e.file = mPath;
-            e.line = static_cast<int>(where.begin.line);
-            e.col = static_cast<int>(where.begin.column);
-            e.sourceLine = lineText(e.line);
-        }
-        mErrors.push_back(std::move(e));
-        return mErrors.back();
-    }
-    SceneError& error(const toml::node& at, std::string message) {
-        return error(at.source(), std::move(message));
-    }
-    SceneError& setError(const std::string& set, std::string message) {
-        SceneError e;
-        e.file = std::string(kSetPrefix) + set;
-        e.message = std::move(message);
-        mErrors.push_back(std::move(e));
-        return mErrors.back();
-    }
-
 private:
-    std::string lineText(int line) const {
-        if (line <= 0 || static_cast<size_t>(line) > mLineStarts.size()) return {};
-        const size_t a = mLineStarts[static_cast<size_t>(line - 1)];
-        size_t b = mText.find('\n', a);
-        if (b == std::string::npos) b = mText.size();
-        if (b > a && mText[b - 1] == '\r') --b;
-        return mText.substr(a, b - a);
-    }
-
-    // Byte offset of a toml++ position (columns count code points).
-    size_t offsetOf(const toml::source_position& p) const {
-        if (p.line == 0 || p.line > mLineStarts.size()) return std::string::npos;
-        size_t i = mLineStarts[p.line - 1];
-        for (uint32_t c = 1; c < p.column && i < mText.size(); ++c) {
-            ++i;
-            while (i < mText.size() && (static_cast<unsigned char>(mText[i]) & 0xC0) == 0x80) ++i;
-        }
-        return i;
-    }
-
-    void checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
-                   const std::string& section);
     bool number(const toml::node& n, const std::string& what, double& out);
     bool integer(const toml::node& n, const std::string& what, long long& out);
-    bool string(const toml::node& n, const std::string& what, std::string& out);
     std::optional<Param> param(const toml::node& n, const std::string& what, int width);
     std::optional<Param> keyframes(const toml::table& t, const std::string& what, int width);
     bool vectorValue(const toml::node& n, std::vector<double>& out);
@@ -113,113 +55,23 @@ private:
     void checkParams(const toml::table& params, const FieldEntry& f, const Scene& scene,
                      const toml::node* sourceNode);
 
-    std::string mPath;
-    const std::string& mText;
-    std::vector<size_t> mLineStarts;
-    std::vector<SceneError>& mErrors;
     const SceneLoadOptions& mOptions;
 };
+
 
 // ---- --set KEY=VALUE ------------------------------------------------------------------------
 
 void Loader::applySets(toml::table& root) {
-    for (const std::string& set : mOptions.sets) {
-        const size_t eq = set.find('=');
-        const std::string key = trimText(eq == std::string::npos ? set : set.substr(0, eq));
-        const std::string text = eq == std::string::npos ? std::string() : trimText(set.substr(eq + 1));
-        const std::vector<std::string> parts = splitText(key, '.');
-        if (eq == std::string::npos || key.empty() || text.empty() ||
-            std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
-            setError(set, "expected KEY=VALUE with a dotted scene path, e.g. windicator.speed=12, "
-                          "field.main.params.speed=8 or scene.fps=30");
-            continue;
-        }
-        const std::string& head = parts[0];
-        if (std::find(mOptions.foreignSections.begin(), mOptions.foreignSections.end(), head) !=
-            mOptions.foreignSections.end())
-            continue; // the solver's loader applies it
-
-        // The value as TOML, else a comma list of numbers, else a bare string (set_value.h).
-        std::optional<toml::table> parsed = parseSetValue(text, std::string(kSetPrefix) + set);
-        if (!parsed) {
-            setError(set, "cannot read the value '" + text + "'");
-            continue;
-        }
-        toml::table doc = std::move(*parsed);
-
-        toml::table* target = nullptr;
-        size_t next = 1;
-        std::string where = head;
-        if (head == "scene" || head == "windicator") {
-            if (!root.contains(head)) root.insert(head, toml::table{});
-            target = root.get(head)->as_table();
-            if (!target) {
-                setError(set, "'" + head + "' in the scene is not a table");
-                continue;
-            }
-        } else if (head == "gust" || head == "field") {
-            toml::array* list = root.get(head) ? root.get(head)->as_array() : nullptr;
-            if (parts.size() < 3) {
-                setError(set, "expected " + head + ".NAME.KEY (or " + head + ".INDEX.KEY, from 0)");
-                continue;
-            }
-            std::vector<std::string> names;
-            if (list) {
-                for (size_t i = 0; i < list->size(); ++i) {
-                    toml::table* t = list->get(i)->as_table();
-                    if (!t) continue;
-                    std::string name =
-                        t->get("name") && t->get("name")->is_string()
-                            ? t->get("name")->value<std::string>().value_or("")
-                            : (head == "field" ? "field" + std::to_string(i) : std::string());
-                    if (!name.empty()) names.push_back(name);
-                    const bool byIndex = parts[1] == std::to_string(i);
-                    if (!target && (name == parts[1] || byIndex)) target = t;
-                }
-            }
-            if (!target) {
-                SceneError& e = setError(set, "the scene has no [[" + head + "]] named '" +
-                                                  parts[1] + "'");
-                std::string hint = didYouMean(parts[1], names);
-                if (!hint.empty()) e.notes.push_back(hint);
-                const size_t count = list ? list->size() : 0;
-                e.notes.push_back("it has " + std::to_string(count) + " [[" + head + "]] entr" +
-                                  (count == 1 ? "y" : "ies") +
-                                  (names.empty() ? std::string()
-                                                 : " (" + joinNames(names) + ")") +
-                                  "; name one, or give its index from 0");
-                continue;
-            }
-            next = 2;
-            where = head + "." + parts[1];
-        } else {
-            SceneError& e = setError(set, "unknown scene section '" + head + "'");
-            std::vector<std::string> known = {"scene", "windicator", "gust", "field"};
-            std::string hint = didYouMean(head, known);
-            if (!hint.empty()) e.notes.push_back(hint);
-            e.notes.push_back("scene paths look like windicator.speed, scene.fps, "
-                              "gust.NAME.strength or field.NAME.params.PARAM");
-            continue;
-        }
-        std::string problem;
-        if (!assignAtPath(*target, parts, next, where, std::move(*doc.get("v")), problem)) setError(set, problem);
-    }
+    SetSections sections;
+    sections.tables = {"scene", "windicator"};
+    sections.lists = {"gust", "field"};
+    sections.foreign = mOptions.foreignSections;
+    sections.pathsNote = "scene paths look like windicator.speed, scene.fps, "
+                         "gust.NAME.strength or field.NAME.params.PARAM";
+    TomlReader::applySets(root, mOptions.sets, sections);
 }
 
 // ---- Values -----------------------------------------------------------------------------------
-
-void Loader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
-                       const std::string& section) {
-    for (auto&& [key, node] : t) {
-        const std::string name(key.str());
-        if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-        SceneError& e = error(key.source().begin.line ? key.source() : node.source(),
-                              "unknown key '" + name + "' in " + section);
-        std::string hint = didYouMean(name, allowed);
-        if (!hint.empty()) e.notes.push_back(hint);
-        e.notes.push_back(section + " keys: " + joinNames(allowed));
-    }
-}
 
 bool Loader::number(const toml::node& n, const std::string& what, double& out) {
     if (!isTomlNumber(n)) {
@@ -248,15 +100,6 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
     error(n, what + " must be a whole number, not " +
                  (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
     return false;
-}
-
-bool Loader::string(const toml::node& n, const std::string& what, std::string& out) {
-    if (!n.is_string()) {
-        error(n, what + " must be a string, not " + tomlTypeName(n));
-        return false;
-    }
-    out = n.value<std::string>().value_or("");
-    return true;
 }
 
 // A number or an array of numbers (false without a report: the caller words the error).
