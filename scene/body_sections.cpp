@@ -1,7 +1,8 @@
-// The scene loader's body sections: [[cloth]], [[hair]], [[collider]] and [solver], read with
-// toml++ after the wind sections (loadSimScene). --set overrides are applied to the TOML tree by dotted
+// The scene loader's body sections: [[cloth]], [[hair]], [[collider]] and [solver], read from
+// the parsed scene after the wind sections (scene/load.cpp). --set overrides are applied to the TOML tree by dotted
 // path first; then every key is checked and converted, every problem reported at file:line:col.
 #include "scene/load.h"
+#include "scene/sections.h"
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "solver/mesh_collider.h"
@@ -644,30 +645,13 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
 
 } // namespace
 
-bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
-                  const std::vector<std::string>& sets) {
-    out = SimScene{};
-    SceneLoadOptions options;
-    options.sets = sets;
-    options.foreignSections = {"cloth", "hair", "collider", "solver"};
-    const size_t before = errors.size();
-    const bool windOk = loadScene(path, out.wind, errors, options);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return false; // loadScene reported it
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    toml::table root;
-    try {
-        root = toml::parse(text, path);
-    } catch (const toml::parse_error&) {
-        return false; // loadScene reported the syntax error
-    }
-    const size_t mine = errors.size();
+void loadBodySections(const std::string& path, const std::string& text, toml::table& root,
+                      SimScene& out, std::vector<fields::SceneError>& errors,
+                      const std::vector<std::string>& sets) {
     Loader loader(path, text, errors);
     loader.applySets(root, sets);
     const std::string baseDir = std::filesystem::path(path).parent_path().string();
     loader.load(root, baseDir.empty() ? std::string(".") : baseDir, out);
-    (void)before;
-    return windOk && errors.size() == mine;
 }
 
 } // namespace gale::scene

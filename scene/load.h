@@ -16,7 +16,7 @@ struct SceneLoadOptions {
     // `--set KEY=VALUE` overrides by dotted path (`windicator.speed=12`, `field.main.params.swirl=0.3`,
     // `scene.fps=30`); an unknown path is an error.
     std::vector<std::string> sets;
-    // Top-level sections another layer parses (the solver passes "cloth", "hair", "collider");
+    // Top-level sections left to the bodies' half of the loader (loadSimScene adds "solver");
     // any other unknown key is an error.
     std::vector<std::string> foreignSections{"cloth", "hair", "collider"};
 };
@@ -27,7 +27,8 @@ struct SceneLoadOptions {
 bool loadScene(const std::string& path, fields::Scene& out, std::vector<fields::SceneError>& errors,
                const SceneLoadOptions& options = {});
 
-// Reads the whole scene: the wind part through loadScene, the solver's sections here.
+// Reads the whole scene, read and parsed once: the wind's sections as loadScene does (the bodies'
+// sections foreign to it), then [[cloth]], [[hair]], [[collider]] and [solver].
 // `sets` are `--set KEY=VALUE` overrides by dotted path (`cloth.cape.drag=0.8`,
 // `collider.0.radius=0.4`, `solver.max_halvings=4`, and the wind's own paths). Every problem
 // is reported at file:line:col; false when there were errors.

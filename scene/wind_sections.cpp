@@ -7,6 +7,7 @@
 #include "fields/presets.h"
 #include "fields/scene.h"
 #include "io/pointset.h"
+#include "scene/sections.h"
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "lang/functions.h"
@@ -591,14 +592,8 @@ void Loader::load(const toml::table& root, Scene& out) {
 
 } // namespace
 
-bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& errors,
-               const SceneLoadOptions& options) {
-    const size_t errorsBefore = errors.size();
-    out = Scene{};
-    out.path = path;
-    out.baseDir = std::filesystem::path(path).parent_path().string();
-
-    std::string text;
+bool readSceneFile(const std::string& path, std::string& text, toml::table& root,
+                   std::vector<SceneError>& errors) {
     {
         std::error_code ec;
         errno = 0;
@@ -614,16 +609,21 @@ bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& err
         }
         text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
-
-    Loader loader(path, text, errors, options);
-    toml::table root;
     try {
         root = toml::parse(text, path);
     } catch (const toml::parse_error& e) {
-        SceneError& se = loader.error(e.source(), std::string(e.description()));
+        TomlReader reader(path, text, errors);
+        SceneError& se = reader.error(e.source(), std::string(e.description()));
         se.file = path;
         return false;
     }
+    return true;
+}
+
+bool loadWindSections(const std::string& path, const std::string& text, toml::table& root,
+                      Scene& out, std::vector<SceneError>& errors, const SceneLoadOptions& options) {
+    const size_t errorsBefore = errors.size();
+    Loader loader(path, text, errors, options);
     loader.applySets(root);
     loader.load(root, out);
     // In file order (--set problems, which have no line, first), as a compiler reports.
