@@ -9,10 +9,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <mutex>
 #include <shared_mutex>
 #include <unordered_map>
+#include <utility>
 
 namespace gale::geometry {
 
@@ -396,33 +398,37 @@ std::shared_ptr<const FileRef> resolveArg(lang::CallSite& site, const std::strin
     return ref;
 }
 
-void loadError(lang::CallSite& site, const FileRef& ref, const FrameFile& file,
-               const io::IoError& e) {
+// A file of `ref` that failed to load (`e` set) is reported at the file argument; true when it
+// loaded.
+bool loaded(lang::CallSite& site, const FileRef& ref, const FrameFile& file, const io::IoError& e) {
+    if (!e) return true;
     site.sink->error(site.argSpans[0], loadMessage(ref, file, e));
+    return false;
+}
+
+// What the mesh built-ins check first: argument 0 a constant string naming a mesh the file policy
+// allows and finds, and each build setting (argument, name) uniform and positive. Every problem
+// of the name and the settings is reported; the file is resolved only when there is none. Null
+// on any problem.
+std::shared_ptr<const FileRef>
+meshArgument(lang::CallSite& site, const char* example,
+             std::initializer_list<std::pair<size_t, const char*>> settings) {
+    const std::string* name = constantString(site, 0, "mesh", example);
+    bool ok = name != nullptr;
+    for (const auto& [arg, what] : settings) ok = buildSetting(site, arg, what) && ok;
+    return ok ? resolveArg(site, *name) : nullptr;
 }
 
 // sdf, sdfgrad, shadow: the mesh loads; with a constant voxel, the first frame's SDF is built.
 bool validateMeshSdf(lang::CallSite& site, size_t voxelArg) {
-    const std::string* name = constantString(site, 0, "mesh", "\"body.obj\"");
-    const bool settings = buildSetting(site, voxelArg, "voxel");
-    if (!name || !settings) return false;
-    std::shared_ptr<const FileRef> ref = resolveArg(site, *name);
+    std::shared_ptr<const FileRef> ref = meshArgument(site, "\"body.obj\"", {{voxelArg, "voxel"}});
     if (!ref) return false;
     const FrameFile& first = ref->frames.front();
     std::shared_ptr<const TriangleMesh> mesh;
-    if (io::IoError e = cachedMesh(first, mesh)) {
-        loadError(site, *ref, first, e);
-        return false;
-    }
+    if (!loaded(site, *ref, first, cachedMesh(first, mesh))) return false;
     const std::vector<double>& voxel = site.constValues[voxelArg];
-    if (!voxel.empty()) {
-        std::shared_ptr<const SdfVolume> sdf;
-        if (io::IoError e = cachedSdf(first, voxel[0], sdf)) {
-            loadError(site, *ref, first, e);
-            return false;
-        }
-    }
-    return true;
+    std::shared_ptr<const SdfVolume> sdf;
+    return voxel.empty() || loaded(site, *ref, first, cachedSdf(first, voxel[0], sdf));
 }
 
 bool validateSdf(lang::CallSite& site) {
@@ -446,40 +452,26 @@ bool validateVdb(lang::CallSite& site) {
     std::shared_ptr<const FileRef> ref = resolveArg(site, *name);
     if (!ref) return false;
     // Every frame's header names the grid with a vector type; the first frame loads fully.
-    for (const FrameFile& file : ref->frames) {
-        if (io::IoError e = checkVdbGrid(file.path, *grid)) {
-            loadError(site, *ref, file, e);
-            return false;
-        }
-    }
+    for (const FrameFile& file : ref->frames)
+        if (!loaded(site, *ref, file, checkVdbGrid(file.path, *grid))) return false;
     std::shared_ptr<const VelocityVolume> volume;
-    if (io::IoError e = cachedVelocity(ref->frames.front(), *grid, volume)) {
-        loadError(site, *ref, ref->frames.front(), e);
-        return false;
-    }
-    return true;
+    return loaded(site, *ref, ref->frames.front(),
+                  cachedVelocity(ref->frames.front(), *grid, volume));
 }
 
 bool validateMeshVel(lang::CallSite& site) {
-    const std::string* name = constantString(site, 0, "mesh", "\"body.#.obj\"");
-    const bool falloff = buildSetting(site, 2, "falloff");
-    const bool voxel = buildSetting(site, 3, "voxel");
-    if (!name || !falloff || !voxel) return false;
-    std::shared_ptr<const FileRef> ref = resolveArg(site, *name);
+    std::shared_ptr<const FileRef> ref =
+        meshArgument(site, "\"body.#.obj\"", {{2, "falloff"}, {3, "voxel"}});
     if (!ref) return false;
     if (!ref->sequence) {
         site.sink->error(site.argSpans[0],
                          "meshvel() needs a per-frame mesh sequence with a '#' for the frame "
                          "number (\"body.#.obj\"); '" +
-                             *name + "' is one mesh, which does not move");
+                             ref->name + "' is one mesh, which does not move");
         return false;
     }
     std::shared_ptr<const TriangleMesh> mesh;
-    if (io::IoError e = cachedMesh(ref->frames.front(), mesh)) {
-        loadError(site, *ref, ref->frames.front(), e);
-        return false;
-    }
-    return true;
+    return loaded(site, *ref, ref->frames.front(), cachedMesh(ref->frames.front(), mesh));
 }
 
 void addGeometryBuiltinsWith(runtime::FunctionTable& t, std::shared_ptr<GeometryContext> ctx) {
