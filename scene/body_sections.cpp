@@ -64,7 +64,6 @@ private:
     bool vec3(const toml::node& n, const std::string& what, Vec3& out);
     bool numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out);
     std::optional<fields::Param> param(const toml::node& n, const std::string& what, int width, double min);
-    std::optional<fields::Param> keyframes(const toml::table& t, const std::string& what, int width, double min);
     bool painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out);
     bool pins(const toml::node& n, const std::string& what, PinSpec& out);
     void stepOptions(const toml::table& t, const std::string& what, StepOptions& s, std::string& output);
@@ -190,69 +189,6 @@ std::optional<fields::Param> Loader::param(const toml::node& n, const std::strin
     std::vector<double> v;
     if (!numbers(n, what, static_cast<size_t>(width), v)) return std::nullopt;
     return fields::Param(std::move(v));
-}
-
-std::optional<fields::Param> Loader::keyframes(const toml::table& t, const std::string& what, int width,
-                                               double min) {
-    checkKeys(t, {"keys", "interp"}, "the keyframed curve of " + what);
-    fields::KeyInterp interp = fields::KeyInterp::Linear;
-    bool ok = true;
-    if (const toml::node* i = t.get("interp")) {
-        std::string name;
-        if (choice(*i, "interpolation of " + what, {"linear", "smooth", "step"}, name))
-            interp = name == "smooth" ? fields::KeyInterp::Smooth
-                                      : name == "step" ? fields::KeyInterp::Step : fields::KeyInterp::Linear;
-        else
-            ok = false;
-    }
-    const toml::node* keysNode = t.get("keys");
-    const toml::array* keys = keysNode ? keysNode->as_array() : nullptr;
-    if (!keys || keys->empty()) {
-        error(keysNode ? *keysNode : static_cast<const toml::node&>(t),
-              what + ": a keyframed curve needs keys = [[t0, v0], [t1, v1], ...]");
-        return std::nullopt;
-    }
-    std::vector<std::pair<double, std::vector<double>>> list;
-    for (const toml::node& k : *keys) {
-        const toml::array* pair = k.as_array();
-        if (!pair || pair->size() != 2 || !isTomlNumber(*pair->get(0))) {
-            error(k, what + ": each key must be [time, value] (time in seconds)");
-            ok = false;
-            continue;
-        }
-        double time = 0.0;
-        if (!number(*pair->get(0), what + ": a key's time", time, -1e300, false)) {
-            ok = false;
-            continue;
-        }
-        std::vector<double> value;
-        if (width == 1) {
-            double v = 0.0;
-            if (!number(*pair->get(1), what + ": a key's value", v, min, false)) {
-                ok = false;
-                continue;
-            }
-            value.push_back(v);
-        } else if (!numbers(*pair->get(1), what + ": a key's value", static_cast<size_t>(width), value)) {
-            ok = false;
-            continue;
-        }
-        for (const auto& e : list)
-            if (e.first == time) {
-                error(k, what + ": two keys at time " + io::formatNumber(time));
-                ok = false;
-            }
-        list.push_back({time, std::move(value)});
-    }
-    if (!ok) return std::nullopt;
-    std::stable_sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<double> times;
-    std::vector<std::vector<double>> values;
-    for (auto& e : list) {
-        times.push_back(e.first);
-        values.push_back(std::move(e.second));
-    }
-    return fields::Param::keyed(std::move(times), std::move(values), interp);
 }
 
 bool Loader::painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out) {

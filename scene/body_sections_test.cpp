@@ -247,3 +247,26 @@ pins = { map = "pin" }
     CHECK(c.pinnedVertices() == std::vector<int>{2, 3});
     CHECK(c.masses().sum() == Approx(0.1)); // default density 0.1 kg/m² × 1 m²
 }
+
+TEST_CASE("scene: keyframed body values go through the one keyframe parser", "[scene][keyframes]") {
+    TempDir dir;
+    const std::string grid = "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n";
+    Loaded ok = load(dir, grid + "drag = { keys = [[0, 1.0], [1, 0.5]], interp = \"smooth\" }\n");
+    INFO(ok.all());
+    REQUIRE(ok.ok);
+    CHECK(ok.scene.cloths[0].drag.value.isKeyed());
+    // A negative key (the bodies' values are at least 0) and an unknown interpolation, each at
+    // its own line and column, the latter with "did you mean"; then two keys at one time.
+    Loaded bad = load(dir, grid + "drag = { keys = [[0, -1.0], [1, 2.0]], interp = \"smoth\" }\n");
+    CHECK_FALSE(bad.ok);
+    const std::string all = bad.all();
+    INFO(all);
+    CHECK(all.find(":4:22: error: [[cloth]] 'c': drag: a key's value must be at least 0, not -1") !=
+          std::string::npos);
+    CHECK(all.find(":4:49: error: unknown interpolation 'smoth'") != std::string::npos);
+    CHECK(all.find("did you mean 'smooth'?") != std::string::npos);
+    Loaded twice = load(dir, grid + "drag = { keys = [[0, 1.0], [0, 2.0]] }\n");
+    CHECK_FALSE(twice.ok);
+    CHECK(twice.all().find(":4:28: error: [[cloth]] 'c': drag: two keys at time 0") !=
+          std::string::npos);
+}

@@ -4,7 +4,11 @@
 
 #include "scene/toml_util.h"
 
+#include "io/pointset.h"
+#include "lang/types.h"
+
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 namespace gale::scene {
@@ -178,6 +182,134 @@ void TomlReader::applySets(toml::table& root, const std::vector<std::string>& se
         if (!assignAtPath(*target, parts, next, where, std::move(*doc.get("v")), problem))
             setError(set, problem);
     }
+}
+
+// ---- values and keyframed curves ----
+
+bool TomlReader::number(const toml::node& n, const std::string& what, double& out) {
+    if (!isTomlNumber(n)) {
+        error(n, what + " must be a number, not " + tomlTypeName(n));
+        return false;
+    }
+    const double v = n.value<double>().value_or(0.0);
+    if (!std::isfinite(v)) {
+        error(n, what + " must be a finite number");
+        return false;
+    }
+    out = v;
+    return true;
+}
+
+bool TomlReader::vectorValue(const toml::node& n, std::vector<double>& out) {
+    out.clear();
+    if (isTomlNumber(n)) {
+        out.push_back(n.value<double>().value_or(0.0));
+        return std::isfinite(out[0]);
+    }
+    const toml::array* a = n.as_array();
+    if (!a || a->empty() || a->size() > static_cast<size_t>(lang::kMaxWidth)) return false;
+    for (const toml::node& e : *a) {
+        if (!isTomlNumber(e)) return false;
+        out.push_back(e.value<double>().value_or(0.0));
+        if (!std::isfinite(out.back())) return false;
+    }
+    return true;
+}
+
+std::optional<fields::Param> TomlReader::keyframes(const toml::table& t, const std::string& what,
+                                                   int width, double min) {
+    checkKeys(t, {"keys", "interp"}, "the keyframed curve of " + what);
+    fields::KeyInterp interp = fields::KeyInterp::Linear;
+    bool ok = true;
+    if (const toml::node* i = t.get("interp")) {
+        std::string name;
+        if (!string(*i, what + ": interp", name)) {
+            ok = false;
+        } else if (name == "linear") {
+            interp = fields::KeyInterp::Linear;
+        } else if (name == "smooth") {
+            interp = fields::KeyInterp::Smooth;
+        } else if (name == "step") {
+            interp = fields::KeyInterp::Step;
+        } else {
+            fields::SceneError& e = error(*i, "unknown interpolation '" + name + "' for " + what +
+                                                  " (use \"linear\", \"smooth\" or \"step\")");
+            std::string hint = didYouMean(name, {"linear", "smooth", "step"});
+            if (!hint.empty()) e.notes.push_back(hint);
+            ok = false;
+        }
+    }
+    const toml::node* keysNode = t.get("keys");
+    if (!keysNode) {
+        error(t, what + ": a keyframed curve needs keys = [[t0, v0], [t1, v1], ...]");
+        return std::nullopt;
+    }
+    const toml::array* keys = keysNode->as_array();
+    if (!keys || keys->empty()) {
+        error(*keysNode, what + ": keys must be a non-empty array of [time, value] pairs");
+        return std::nullopt;
+    }
+    struct Key {
+        double time;
+        std::vector<double> value;
+        const toml::node* node;
+    };
+    std::vector<Key> list;
+    int keyWidth = width;
+    for (const toml::node& k : *keys) {
+        const toml::array* pair = k.as_array();
+        double time = 0.0;
+        std::vector<double> value;
+        if (!pair || pair->size() != 2 || !isTomlNumber(*pair->get(0))) {
+            error(k, what + ": each key must be [time, value] (time in seconds)");
+            ok = false;
+            continue;
+        }
+        if (!number(*pair->get(0), what + ": a key's time", time)) {
+            ok = false;
+            continue;
+        }
+        if (!vectorValue(*pair->get(1), value)) {
+            error(*pair->get(1),
+                  what + ": a key's value must be " +
+                      (keyWidth ? widthText(keyWidth) : std::string("a number or a vector")));
+            ok = false;
+            continue;
+        }
+        if (keyWidth == 0) keyWidth = static_cast<int>(value.size());
+        if (static_cast<int>(value.size()) != keyWidth) {
+            error(*pair->get(1), what + ": a key's value must be " + widthText(keyWidth) +
+                                     " like the " + (width ? "parameter" : "first key") + ", not " +
+                                     std::to_string(value.size()) + " number" +
+                                     (value.size() == 1 ? "" : "s"));
+            ok = false;
+            continue;
+        }
+        if (keyWidth == 1 && !(value[0] >= min)) {
+            error(*pair->get(1), what + ": a key's value must be at least " +
+                                     io::formatNumber(min) + ", not " + io::formatNumber(value[0]));
+            ok = false;
+            continue;
+        }
+        list.push_back({time, std::move(value), &k});
+    }
+    std::stable_sort(list.begin(), list.end(),
+                     [](const Key& a, const Key& b) { return a.time < b.time; });
+    for (size_t i = 1; i < list.size(); ++i) {
+        if (list[i].time == list[i - 1].time) {
+            error(*list[i].node, what + ": two keys at time " + io::formatNumber(list[i].time) +
+                                     " (each key needs its own time)");
+            ok = false;
+        }
+    }
+    if (!ok) return std::nullopt;
+    std::vector<double> times;
+    std::vector<std::vector<double>> values;
+    for (Key& k : list) {
+        times.push_back(k.time);
+        values.push_back(std::move(k.value));
+    }
+    return fields::Param::keyed(std::move(times), std::move(values), interp);
 }
 
 } // namespace gale::scene

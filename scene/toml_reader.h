@@ -8,11 +8,19 @@
 
 #include <toml++/toml.h>
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace gale::scene {
+
+// "a number" or "a vector of N numbers".
+inline std::string widthText(int width) {
+    return width == 1 ? std::string("a number")
+                      : "a vector of " + std::to_string(width) + " numbers";
+}
 
 inline constexpr std::string_view kSetPrefix = "--set ";
 
@@ -51,6 +59,17 @@ public:
     void checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
                    const std::string& section);
     bool string(const toml::node& n, const std::string& what, std::string& out);
+    // A finite number.
+    bool number(const toml::node& n, const std::string& what, double& out);
+    // A finite number or a non-empty array of finite numbers (up to the language's widest
+    // vector); false without a report (the caller words the error).
+    bool vectorValue(const toml::node& n, std::vector<double>& out);
+    // The one parser of keyframed curves, { keys = [[t0, v0], [t1, v1], ...], interp = "linear"
+    // | "smooth" | "step" }: values of `width` numbers (0: any, the same for every key), scalar
+    // values at least `min`; times distinct, keys sorted by time. Every problem is reported at
+    // its key.
+    std::optional<fields::Param> keyframes(const toml::table& t, const std::string& what, int width,
+                                           double min = -HUGE_VAL);
 
 protected:
     std::string lineText(int line) const;

@@ -41,11 +41,8 @@ public:
     void load(const toml::table& root, Scene& out);
 
 private:
-    bool number(const toml::node& n, const std::string& what, double& out);
     bool integer(const toml::node& n, const std::string& what, long long& out);
     std::optional<Param> param(const toml::node& n, const std::string& what, int width);
-    std::optional<Param> keyframes(const toml::table& t, const std::string& what, int width);
-    bool vectorValue(const toml::node& n, std::vector<double>& out);
     void verbatimPosition(const toml::node& n, const std::string& value, int& line, int& col) const;
 
     void loadSettings(const toml::table& t, SceneSettings& s);
@@ -74,20 +71,6 @@ void Loader::applySets(toml::table& root) {
 
 // ---- Values -----------------------------------------------------------------------------------
 
-bool Loader::number(const toml::node& n, const std::string& what, double& out) {
-    if (!isTomlNumber(n)) {
-        error(n, what + " must be a number, not " + tomlTypeName(n));
-        return false;
-    }
-    const double v = n.value<double>().value_or(0.0);
-    if (!std::isfinite(v)) {
-        error(n, what + " must be a finite number");
-        return false;
-    }
-    out = v;
-    return true;
-}
-
 bool Loader::integer(const toml::node& n, const std::string& what, long long& out) {
     double v = 0.0;
     if (n.is_integer()) {
@@ -101,28 +84,6 @@ bool Loader::integer(const toml::node& n, const std::string& what, long long& ou
     error(n, what + " must be a whole number, not " +
                  (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
     return false;
-}
-
-// A number or an array of numbers (false without a report: the caller words the error).
-bool Loader::vectorValue(const toml::node& n, std::vector<double>& out) {
-    out.clear();
-    if (isTomlNumber(n)) {
-        out.push_back(n.value<double>().value_or(0.0));
-        return std::isfinite(out[0]);
-    }
-    const toml::array* a = n.as_array();
-    if (!a || a->empty() || a->size() > static_cast<size_t>(lang::kMaxWidth)) return false;
-    for (const toml::node& e : *a) {
-        if (!isTomlNumber(e)) return false;
-        out.push_back(e.value<double>().value_or(0.0));
-        if (!std::isfinite(out.back())) return false;
-    }
-    return true;
-}
-
-std::string widthText(int width) {
-    return width == 1 ? std::string("a number")
-                      : "a vector of " + std::to_string(width) + " numbers";
 }
 
 // A numeric parameter: a number, a vector, or a keyframed curve. `width` 0 accepts any width.
@@ -145,94 +106,6 @@ std::optional<Param> Loader::param(const toml::node& n, const std::string& what,
     }
     if (!n.is_array()) return Param(v[0]);
     return Param(std::move(v));
-}
-
-std::optional<Param> Loader::keyframes(const toml::table& t, const std::string& what, int width) {
-    checkKeys(t, {"keys", "interp"}, "the keyframed curve of " + what);
-    KeyInterp interp = KeyInterp::Linear;
-    bool ok = true;
-    if (const toml::node* i = t.get("interp")) {
-        std::string name;
-        if (!string(*i, what + ": interp", name)) {
-            ok = false;
-        } else if (name == "linear") {
-            interp = KeyInterp::Linear;
-        } else if (name == "smooth") {
-            interp = KeyInterp::Smooth;
-        } else if (name == "step") {
-            interp = KeyInterp::Step;
-        } else {
-            SceneError& e = error(*i, "unknown interpolation '" + name + "' for " + what +
-                                          " (use \"linear\", \"smooth\" or \"step\")");
-            std::string hint = didYouMean(name, {"linear", "smooth", "step"});
-            if (!hint.empty()) e.notes.push_back(hint);
-            ok = false;
-        }
-    }
-    const toml::node* keysNode = t.get("keys");
-    if (!keysNode) {
-        error(t, what + ": a keyframed curve needs keys = [[t0, v0], [t1, v1], ...]");
-        return std::nullopt;
-    }
-    const toml::array* keys = keysNode->as_array();
-    if (!keys || keys->empty()) {
-        error(*keysNode, what + ": keys must be a non-empty array of [time, value] pairs");
-        return std::nullopt;
-    }
-    struct Key {
-        double time;
-        std::vector<double> value;
-        const toml::node* node;
-    };
-    std::vector<Key> list;
-    int keyWidth = width;
-    for (const toml::node& k : *keys) {
-        const toml::array* pair = k.as_array();
-        double time = 0.0;
-        std::vector<double> value;
-        if (!pair || pair->size() != 2 || !isTomlNumber(*pair->get(0))) {
-            error(k, what + ": each key must be [time, value] (time in seconds)");
-            ok = false;
-            continue;
-        }
-        if (!number(*pair->get(0), what + ": a key's time", time)) {
-            ok = false;
-            continue;
-        }
-        if (!vectorValue(*pair->get(1), value)) {
-            error(*pair->get(1), what + ": a key's value must be " +
-                                     (keyWidth ? widthText(keyWidth) : std::string("a number or a vector")));
-            ok = false;
-            continue;
-        }
-        if (keyWidth == 0) keyWidth = static_cast<int>(value.size());
-        if (static_cast<int>(value.size()) != keyWidth) {
-            error(*pair->get(1), what + ": a key's value must be " + widthText(keyWidth) +
-                                     " like the " + (width ? "parameter" : "first key") + ", not " +
-                                     std::to_string(value.size()) + " number" +
-                                     (value.size() == 1 ? "" : "s"));
-            ok = false;
-            continue;
-        }
-        list.push_back({time, std::move(value), &k});
-    }
-    std::stable_sort(list.begin(), list.end(),
-                     [](const Key& a, const Key& b) { return a.time < b.time; });
-    for (size_t i = 1; i < list.size(); ++i) {
-        if (list[i].time == list[i - 1].time) {
-            error(*list[i].node, what + ": two keys at time " + io::formatNumber(list[i].time) +
-                                     " (each key needs its own time)");
-            ok = false;
-        }
-    }
-    if (!ok) return std::nullopt;
-    std::vector<double> times;
-    std::vector<std::vector<double>> values;
-    for (Key& k : list) {
-        times.push_back(k.time);
-        values.push_back(std::move(k.value));
-    }
-    return Param::keyed(std::move(times), std::move(values), interp);
 }
 
 // Where a string's text starts in the scene when the TOML holds it verbatim (literal strings,
