@@ -20,6 +20,8 @@
 
 using namespace gale;
 using namespace gale::fields;
+using namespace gale::geometry;
+using namespace gale::io;
 
 namespace {
 
