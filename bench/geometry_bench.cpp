@@ -3,10 +3,10 @@
 // points, per thread) and through the VM — on 1 thread and on all threads.
 // Usage: gale_bench_geometry [points=400000] [body.obj=examples/04_shelter/body.obj]
 #include "fields/expression_field.h"
-#include "fields/geometry.h"
-#include "fields/geometry_cache.h"
 #include "fields/grid_sample.h"
-#include "fields/vdb_io.h"
+#include "geometry/cache.h"
+#include "geometry/geometry.h"
+#include "geometry/vdb_io.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +20,8 @@
 
 using namespace gale;
 using namespace gale::fields;
+using namespace gale::geometry;
+using namespace gale::io;
 
 namespace {
 

@@ -2,7 +2,7 @@
 // same points on every machine), repeat, and print the best time per point.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "fields/geometry_paths.h"
+#include "geometry/file_policy.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/info.h>
@@ -85,7 +85,7 @@ int runBench(const BenchOptions& o) {
     Bindings bindings(o.time, o.time * 24.0, 24.0);
     bindings.setVarying("P", 3, positions.data(), 3, 1);
     bindings.addSets(sets);
-    const fields::FileAccess files = fields::fileAccessFor(o.source.file, o.source.allowPaths);
+    const geometry::FileAccess files = geometry::fileAccessFor(o.source.file, o.source.allowPaths);
     std::shared_ptr<const runtime::Program> program = compileAndReport(
         source, bindings.variables(), wantWidthFor(o.source.type), nullptr, &files);
     if (!program) return kExitInput;

@@ -6,6 +6,7 @@
 #include "cli/field_input.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "scene/load.h"
 
 #include <CLI/CLI.hpp>
 
@@ -23,9 +24,9 @@ int checkScene(const std::string& path, const std::vector<std::string>& sets,
                const std::vector<std::string>& allowPaths) {
     fields::Scene scene;
     std::vector<fields::SceneError> errors;
-    fields::SceneLoadOptions options;
+    gale::scene::SceneLoadOptions options;
     options.sets = sets;
-    if (!fields::loadScene(path, scene, errors, options)) {
+    if (!gale::scene::loadScene(path, scene, errors, options)) {
         bool io = false;
         for (const fields::SceneError& e : errors) {
             std::cerr << e.render() << '\n';
@@ -54,7 +55,7 @@ int runCheck(const CheckOptions& options) {
         printError("nothing to check: give expression files (FILE.se...) or -e EXPR");
         return kExitUsage;
     }
-    fields::PointSet points;
+    io::PointSet points;
     if (!options.points.empty()) {
         if (int rc = loadPoints(options.points, points)) return rc;
     }
@@ -78,7 +79,7 @@ int runCheck(const CheckOptions& options) {
         Bindings local = bindings;
         const lang::SourceFile compiled = bindParameters(source, local);
         local.addSets(sets);
-        const fields::FileAccess files = fields::fileAccessFor(file, options.allowPaths);
+        const geometry::FileAccess files = geometry::fileAccessFor(file, options.allowPaths);
         if (!compileAndReport(compiled, local.variables(), wantWidthFor(options.type), &source,
                               &files))
             sawError = true;

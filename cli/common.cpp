@@ -1,7 +1,7 @@
 // Helpers shared by the subcommands: sources, --set values, host bindings, compiling with
 // diagnostics on stderr, number output and atomic text files.
 #include "cli/common.h"
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
 
 #include "fields/expression_field.h"
 
@@ -213,9 +213,9 @@ void Bindings::setVarying(const std::string& name, int width, const double* data
     mVaryings.push_back(v);
 }
 
-void Bindings::addPoints(const fields::PointSet& points) {
+void Bindings::addPoints(const io::PointSet& points) {
     const size_t n = points.size();
-    for (const fields::PointVariable& pv : fields::pointVariables(points)) {
+    for (const io::PointVariable& pv : io::pointVariables(points)) {
         const int width = static_cast<int>(pv.columns.size());
         if (width == 1) {
             setVarying(pv.name, 1, points.columns[static_cast<size_t>(pv.columns[0])].data(), 1, 1);
@@ -250,7 +250,7 @@ void Bindings::fillRequest(runtime::EvalRequest& request) const {
 
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
-                 int wantWidth, const lang::SourceFile* shown, const fields::FileAccess* files) {
+                 int wantWidth, const lang::SourceFile* shown, const geometry::FileAccess* files) {
     runtime::CompileSettings settings;
     settings.variables = variables;
     settings.wantWidth = wantWidth;
@@ -273,22 +273,22 @@ lang::SourceFile bindParameters(const lang::SourceFile& source, Bindings& bindin
     return fields::withoutParameters(source, params);
 }
 
-int loadPoints(const std::string& path, fields::PointSet& points) {
-    fields::IoError e = fields::readPoints(path, points, &std::cin);
+int loadPoints(const std::string& path, io::PointSet& points) {
+    io::IoError e = io::readPoints(path, points, &std::cin);
     if (!e) return kExitOk;
     std::cerr << e.render() << '\n';
-    return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+    return e.kind == io::IoError::Io ? kExitIo : kExitInput;
 }
 
 std::string formatValue(double v, bool asFloat) {
-    if (!asFloat || !std::isfinite(v)) return fields::formatNumber(v);
+    if (!asFloat || !std::isfinite(v)) return io::formatNumber(v);
     char buf[64];
     std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, static_cast<float>(v));
     return std::string(buf, r.ptr);
 }
 
 int writeTextFileAtomic(const std::string& path, const std::string& text) {
-    fields::IoError e = fields::writeBytesAtomic(path, text);
+    io::IoError e = io::writeBytesAtomic(path, text);
     if (e) {
         printError(e.render());
         return kExitIo;

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "cli/commands.h"
-#include "fields/pointset.h"
+#include "io/pointset.h"
 #include "lang/source.h"
 #include "runtime/program.h"
 
@@ -20,9 +20,9 @@ class App;
 class Option;
 } // namespace CLI
 
-namespace gale::fields {
+namespace gale::geometry {
 struct FileAccess;
-} // namespace gale::fields
+} // namespace gale::geometry
 
 namespace gale::cli {
 
@@ -65,7 +65,7 @@ public:
                     std::ptrdiff_t pointStride, std::ptrdiff_t compStride);
     // Every column of `points` as a varying variable (P from x,y,z, ...); multi-component
     // variables are interleaved into storage owned here. `points` must outlive evaluation.
-    void addPoints(const fields::PointSet& points);
+    void addPoints(const io::PointSet& points);
     void addSets(const std::vector<SetValue>& sets);
 
     const std::vector<lang::HostVariable>& variables() const { return mVariables; }
@@ -90,7 +90,7 @@ private:
 std::shared_ptr<const runtime::Program>
 compileAndReport(const lang::SourceFile& source, const std::vector<lang::HostVariable>& variables,
                  int wantWidth, const lang::SourceFile* shown = nullptr,
-                 const fields::FileAccess* files = nullptr);
+                 const geometry::FileAccess* files = nullptr);
 
 // Adds `--allow-path DIR` (repeatable) to a subcommand.
 void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths);
@@ -101,7 +101,7 @@ void addAllowPathOption(CLI::App& app, std::vector<std::string>& allowPaths);
 lang::SourceFile bindParameters(const lang::SourceFile& source, Bindings& bindings);
 
 // Reads a point file, printing IoError::render() on failure; returns an exit code.
-int loadPoints(const std::string& path, fields::PointSet& points);
+int loadPoints(const std::string& path, io::PointSet& points);
 
 // Shortest round-trip text of a value computed in float (`asFloat`) or double.
 std::string formatValue(double v, bool asFloat);
@@ -119,7 +119,7 @@ constexpr long kMaxFrames = 100'000;
 bool parseFrames(const std::string& text, int& a, int& b);
 
 // A JSON string literal (the point-set writer's escaping, so every JSON gale writes agrees).
-using fields::jsonString;
+using io::jsonString;
 
 // Word-wraps help text to `width` columns (CLI11 indents the continuation lines).
 std::string wrapHelp(const std::string& text, size_t width = 62);

@@ -4,9 +4,10 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/field_input.h"
-#include "fields/atomic_file.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "io/atomic_file.h"
+#include "scene/load.h"
 
 #include <CLI/CLI.hpp>
 
@@ -25,27 +26,27 @@ namespace {
 
 // Output format from --format, else the -o extension, else CSV. False (after printing) when
 // neither names a known format.
-bool chooseFormat(const EvalOptions& o, fields::PointFormat& format) {
+bool chooseFormat(const EvalOptions& o, io::PointFormat& format) {
     if (!o.format.empty()) {
         if (o.format == "csv")
-            format = fields::PointFormat::Csv;
+            format = io::PointFormat::Csv;
         else if (o.format == "ply")
-            format = fields::PointFormat::Ply;
+            format = io::PointFormat::Ply;
         else if (o.format == "ply-ascii")
-            format = fields::PointFormat::PlyAscii;
+            format = io::PointFormat::PlyAscii;
         else if (o.format == "json")
-            format = fields::PointFormat::Json;
+            format = io::PointFormat::Json;
         else if (o.format == "npy")
-            format = fields::PointFormat::Npy;
+            format = io::PointFormat::Npy;
         else if (o.format == "obj")
-            format = fields::PointFormat::Obj;
+            format = io::PointFormat::Obj;
         else
             return false; // CLI11 has already checked the name
         return true;
     }
-    format = fields::PointFormat::Csv;
+    format = io::PointFormat::Csv;
     if (o.output.empty() || o.output == "-") return true;
-    if (fields::formatFromPath(o.output, format)) return true;
+    if (io::formatFromPath(o.output, format)) return true;
     printError("cannot tell the output format from '" + o.output +
                "': use a .csv, .ply, .json, .npy or .obj name, or --format");
     return false;
@@ -103,7 +104,7 @@ int writeValueLine(const EvalOptions& o, std::string line) {
 
 // Adds the result columns (point-major `values`, `width` per point) to the points, replacing
 // columns of the same names; returns their indices.
-std::vector<int> addResultColumns(fields::PointSet& points, const std::vector<double>& values,
+std::vector<int> addResultColumns(io::PointSet& points, const std::vector<double>& values,
                                   int width, bool asFloat) {
     std::vector<int> added;
     for (const std::string& name : resultColumns(width)) added.push_back(points.addColumn(name));
@@ -122,31 +123,29 @@ std::vector<int> addResultColumns(fields::PointSet& points, const std::vector<do
 
 // Writes the points with the result columns (point-major `values`, `width` per point) added,
 // replacing columns of the same names.
-int writePointResults(const EvalOptions& o, fields::PointSet& points,
-                      const std::vector<double>& values, int width, bool asFloat,
-                      fields::PointFormat format) {
+int writePointResults(const EvalOptions& o, io::PointSet& points, const std::vector<double>& values,
+                      int width, bool asFloat, io::PointFormat format) {
     const std::vector<int> added = addResultColumns(points, values, width, asFloat);
-    const std::vector<int> npyColumns =
-        format == fields::PointFormat::Npy ? added : std::vector<int>{};
+    const std::vector<int> npyColumns = format == io::PointFormat::Npy ? added : std::vector<int>{};
     if (o.output.empty() || o.output == "-") {
-        fields::IoError e = fields::writePoints(std::cout, points, format, npyColumns);
+        io::IoError e = io::writePoints(std::cout, points, format, npyColumns);
         std::cout.flush();
         if (e || !std::cout) {
             printError("cannot write to stdout" + (e ? ": " + e.message : std::string()));
-            return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
+            return e.kind == io::IoError::Data ? kExitInput : kExitIo;
         }
         return kExitOk;
     }
-    fields::IoError e = fields::writePointsFile(o.output, points, format, npyColumns);
+    io::IoError e = io::writePointsFile(o.output, points, format, npyColumns);
     if (e) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Data ? kExitInput : kExitIo;
+        return e.kind == io::IoError::Data ? kExitInput : kExitIo;
     }
     return kExitOk;
 }
 
 // Checks that the points (or a CSV header) have x, y, z columns; returns an exit code.
-int checkXyz(const std::string& path, const fields::PointSet& points) {
+int checkXyz(const std::string& path, const io::PointSet& points) {
     if (points.find("x") < 0 || points.find("y") < 0 || points.find("z") < 0) {
         std::string have;
         for (const std::string& n : points.names) have += (have.empty() ? "" : ", ") + n;
@@ -159,7 +158,7 @@ int checkXyz(const std::string& path, const fields::PointSet& points) {
 }
 
 // Reads --points and checks for x, y, z; returns an exit code.
-int loadEvalPoints(const std::string& path, fields::PointSet& points) {
+int loadEvalPoints(const std::string& path, io::PointSet& points) {
     if (int rc = loadPoints(path, points)) return rc;
     return checkXyz(path, points);
 }
@@ -170,23 +169,22 @@ constexpr size_t kStreamChunk = size_t(1) << 20; // points per chunk
 
 // Points stream when they are read from CSV and written as CSV, unless --checked output goes to
 // stdout (a non-finite value found late must leave no output, and stdout cannot be taken back).
-bool streamsPoints(const EvalOptions& o, fields::PointFormat format) {
-    fields::PointFormat in = fields::PointFormat::Csv;
-    if (o.points != "-" && !fields::formatFromPath(o.points, in)) return false;
+bool streamsPoints(const EvalOptions& o, io::PointFormat format) {
+    io::PointFormat in = io::PointFormat::Csv;
+    if (o.points != "-" && !io::formatFromPath(o.points, in)) return false;
     const bool toStdout = o.output.empty() || o.output == "-";
-    return in == fields::PointFormat::Csv && format == fields::PointFormat::Csv &&
-           !(o.checked && toStdout);
+    return in == io::PointFormat::Csv && format == io::PointFormat::Csv && !(o.checked && toStdout);
 }
 
 struct PointStream {
     std::ifstream file;
-    std::unique_ptr<fields::CsvPointReader> reader;
-    fields::PointSet header; // the columns, no rows
+    std::unique_ptr<io::CsvPointReader> reader;
+    io::PointSet header; // the columns, no rows
 };
 
-int printIoError(const fields::IoError& e) {
+int printIoError(const io::IoError& e) {
     std::cerr << e.render() << '\n';
-    return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+    return e.kind == io::IoError::Io ? kExitIo : kExitInput;
 }
 
 // Opens --points and reads its header (which must name x, y and z); returns an exit code.
@@ -205,39 +203,39 @@ int openPointStream(const std::string& path, PointStream& s) {
         name = path;
         std::error_code ec;
         if (std::filesystem::is_directory(path, ec))
-            return printIoError(fields::ioErrorAt(path, "cannot read", EISDIR));
+            return printIoError(io::ioErrorAt(path, "cannot read", EISDIR));
         errno = 0;
         s.file.open(path, std::ios::binary);
-        if (!s.file) return printIoError(fields::ioErrorAt(path, "cannot open", errno));
+        if (!s.file) return printIoError(io::ioErrorAt(path, "cannot open", errno));
         in = &s.file;
     }
-    s.reader = std::make_unique<fields::CsvPointReader>(*in, name);
-    if (fields::IoError e = s.reader->readHeader(s.header)) return printIoError(e);
+    s.reader = std::make_unique<io::CsvPointReader>(*in, name);
+    if (io::IoError e = s.reader->readHeader(s.header)) return printIoError(e);
     return checkXyz(path, s.header);
 }
 
 // Evaluates one chunk (points first .. first + chunk.size() - 1) and adds its result columns;
 // adds the number of points with a non-finite result to `bad` (--checked); returns an exit code.
-using ChunkEval = std::function<int(fields::PointSet& chunk, size_t first, size_t& bad)>;
+using ChunkEval = std::function<int(io::PointSet& chunk, size_t first, size_t& bad)>;
 
 // Reads, evaluates and writes chunk after chunk. After a chunk with non-finite results
 // (--checked) the rest is still evaluated, to count them, but nothing more is written and the
 // output file is not created: `reportBad(bad, total)` gives the exit code.
 int streamPoints(const EvalOptions& o, PointStream& s, const ChunkEval& eval,
                  const std::function<int(size_t bad, size_t total)>& reportBad) {
-    fields::IoError writeError;
+    io::IoError writeError;
     auto run = [&](std::ostream* out) -> int {
-        fields::PointSet chunk;
+        io::PointSet chunk;
         size_t total = 0, bad = 0;
         for (bool first = true;; first = false) {
-            if (fields::IoError e = s.reader->readRows(chunk, kStreamChunk)) return printIoError(e);
+            if (io::IoError e = s.reader->readRows(chunk, kStreamChunk)) return printIoError(e);
             const size_t n = chunk.size();
             if (n == 0 && !first) break;
             if (int rc = eval(chunk, total, bad)) return rc;
             total += n;
             if (bad > 0) out = nullptr;
             if (out) {
-                writeError = fields::writePointsCsv(*out, chunk, first);
+                writeError = io::writePointsCsv(*out, chunk, first);
                 if (writeError) return kExitIo;
             }
             if (n == 0) break;
@@ -258,22 +256,22 @@ int streamPoints(const EvalOptions& o, PointStream& s, const ChunkEval& eval,
         return rc;
     }
     int rc = kExitOk;
-    fields::IoError e = fields::writeFileAtomic(o.output, [&](const std::string& tmp) -> fields::IoError {
+    io::IoError e = io::writeFileAtomic(o.output, [&](const std::string& tmp) -> io::IoError {
         errno = 0;
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) return fields::ioErrorAt(o.output, "cannot write", errno);
+        if (!f) return io::ioErrorAt(o.output, "cannot write", errno);
         rc = run(&f);
-        if (rc == kExitIo && writeError) return fields::ioErrorAt(o.output, "cannot write", errno);
+        if (rc == kExitIo && writeError) return io::ioErrorAt(o.output, "cannot write", errno);
         if (rc) { // already reported; the temporary file is removed
-            fields::IoError stop;
-            stop.kind = fields::IoError::Data;
+            io::IoError stop;
+            stop.kind = io::IoError::Data;
             return stop;
         }
         f.flush();
         const int err = errno;
         f.close();
-        if (f.fail()) return fields::ioErrorAt(o.output, "cannot write", err);
-        return fields::IoError{};
+        if (f.fail()) return io::ioErrorAt(o.output, "cannot write", err);
+        return io::IoError{};
     });
     if (rc && !(rc == kExitIo && writeError)) return rc;
     if (e) return printIoError(e);
@@ -293,8 +291,7 @@ int reportSceneErrors(const std::vector<fields::SceneError>& errors) {
 
 // `gale eval SCENE.toml`: the scene's summed wind at the origin or at every point. --set
 // overrides scene keys by dotted path; --fps defaults to the scene's.
-int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
-                 fields::PointFormat format) {
+int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints, io::PointFormat format) {
     if (o.disasm) {
         printError("--disasm needs an expression (FILE.se or -e EXPR), not a scene");
         return kExitUsage;
@@ -305,9 +302,9 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
     }
     fields::Scene scene;
     std::vector<fields::SceneError> errors;
-    fields::SceneLoadOptions options;
+    gale::scene::SceneLoadOptions options;
     options.sets = o.source.sets;
-    if (!fields::loadScene(o.source.file, scene, errors, options))
+    if (!gale::scene::loadScene(o.source.file, scene, errors, options))
         return reportSceneErrors(errors);
     const bool asFloat = o.precision != "double";
     std::string report;
@@ -326,7 +323,7 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
         PointStream stream;
         if (int rc = openPointStream(o.points, stream)) return rc;
         std::vector<double> positions, velocities;
-        auto eval = [&](fields::PointSet& chunk, size_t, size_t& bad) -> int {
+        auto eval = [&](io::PointSet& chunk, size_t, size_t& bad) -> int {
             const size_t n = chunk.size();
             positions.assign(3 * n, 0.0);
             const int axes[3] = {chunk.find("x"), chunk.find("y"), chunk.find("z")};
@@ -356,7 +353,7 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints,
             return kExitNumeric;
         });
     }
-    fields::PointSet points;
+    io::PointSet points;
     if (havePoints) {
         if (int rc = loadEvalPoints(o.points, points)) return rc;
     }
@@ -413,10 +410,10 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     std::vector<SetValue> sets;
     if (!scene && !parseSets(o.source.sets, sets)) return kExitUsage;
     const bool havePoints = !o.points.empty();
-    fields::PointFormat format = fields::PointFormat::Csv;
+    io::PointFormat format = io::PointFormat::Csv;
     if (havePoints) {
-        fields::PointFormat inFormat;
-        if (o.points != "-" && !fields::formatFromPath(o.points, inFormat)) {
+        io::PointFormat inFormat;
+        if (o.points != "-" && !io::formatFromPath(o.points, inFormat)) {
             printError("cannot tell the point file type of '" + o.points +
                        "': use .csv, .ply or .obj");
             return kExitUsage;
@@ -436,7 +433,7 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
 
     const bool stream = havePoints && streamsPoints(o, format);
     PointStream pointStream;
-    fields::PointSet points;
+    io::PointSet points;
     if (stream) {
         if (int rc = openPointStream(o.points, pointStream)) return rc;
         points = pointStream.header; // no rows: the columns give the variables' types
@@ -449,7 +446,7 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
     const lang::SourceFile compiled = bindParameters(source, bindings);
     bindings.addSets(sets);
 
-    const fields::FileAccess files = fields::fileAccessFor(o.source.file, o.source.allowPaths);
+    const geometry::FileAccess files = geometry::fileAccessFor(o.source.file, o.source.allowPaths);
     std::shared_ptr<const runtime::Program> program = compileAndReport(
         compiled, bindings.variables(), wantWidthFor(o.source.type), &source, &files);
     if (!program) return kExitInput;
@@ -472,7 +469,7 @@ int runEvalImpl(const EvalOptions& o, bool fpsGiven) {
         std::vector<std::string> strings;
         runtime::EvalResult firstBad; // --checked: the evaluation that found the first one
         const std::vector<fields::ParameterDecl> params = fields::findParameters(source);
-        auto eval = [&](fields::PointSet& chunk, size_t first, size_t& bad) -> int {
+        auto eval = [&](io::PointSet& chunk, size_t first, size_t& bad) -> int {
             const size_t n = chunk.size();
             ids.resize(n);
             for (size_t i = 0; i < n; ++i) ids[i] = static_cast<double>(first + i);

@@ -4,6 +4,7 @@
 
 #include "cli/common.h"
 #include "fields/expression_field.h"
+#include "scene/load.h"
 
 #include <algorithm>
 #include <cctype>
@@ -67,7 +68,7 @@ int loadExpression(const SourceOptions& source, FieldInput& out) {
     const std::vector<fields::ParameterDecl> declared = fields::findParameters(file);
     fields::ExpressionFieldOptions options;
     options.precision = runtime::Precision::Float;
-    options.files = fields::fileAccessFor(source.file, source.allowPaths);
+    options.files = geometry::fileAccessFor(source.file, source.allowPaths);
     std::vector<runtime::UniformValue> extras;
     for (const SetValue& s : sets) {
         const bool isParameter =
@@ -118,9 +119,9 @@ int loadExpression(const SourceOptions& source, FieldInput& out) {
 int loadSceneInput(const SourceOptions& source, FieldInput& out) {
     auto scene = std::make_shared<fields::Scene>();
     std::vector<fields::SceneError> errors;
-    fields::SceneLoadOptions options;
+    gale::scene::SceneLoadOptions options;
     options.sets = source.sets;
-    if (!fields::loadScene(source.file, *scene, errors, options)) {
+    if (!gale::scene::loadScene(source.file, *scene, errors, options)) {
         bool io = false;
         for (const fields::SceneError& e : errors) {
             std::string text = e.render();

@@ -6,7 +6,9 @@
 #include "cli/common.h"
 #include "cli/wedge.h"
 #include "fields/grid_sample.h"
+#include "scene/load.h"
 #include "solver/scene.h"
+#include "viz/cairo_render.h"
 
 #include <algorithm>
 #include <cctype>
@@ -159,10 +161,11 @@ std::string jsonText(const Json& j) {
 }
 
 // The (u, v) extent of every geometry, padded; false when there is none.
-bool geometryBounds(const std::vector<const GeometryOverlay*>& all, int uAxis, int vAxis, std::array<double, 4>& b) {
+bool geometryBounds(const std::vector<const viz::GeometryOverlay*>& all, int uAxis, int vAxis,
+                    std::array<double, 4>& b) {
     double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     double hi[2] = {-lo[0], -lo[1]};
-    for (const GeometryOverlay* g : all)
+    for (const viz::GeometryOverlay* g : all)
         for (const auto& p : g->points) {
             if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
             lo[0] = std::min(lo[0], p[uAxis]);
@@ -231,61 +234,6 @@ bool parseFrameList(const std::string& text, std::vector<long>& out, std::string
     return true;
 }
 
-bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::string& error) {
-    out = GeometryOverlay{};
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".obj") {
-        std::ifstream in(path);
-        if (!in) {
-            error = path + ": cannot read: no such file (run gale sim first?)";
-            return false;
-        }
-        auto index = [&](const std::string& word) {
-            const int i = std::atoi(word.c_str()); // "7", "7/1/2": the vertex
-            return i > 0 ? i - 1 : static_cast<int>(out.points.size()) + i;
-        };
-        for (std::string line; std::getline(in, line);) {
-            std::istringstream words(line);
-            std::string tag;
-            words >> tag;
-            if (tag == "v") {
-                std::array<double, 3> p{};
-                words >> p[0] >> p[1] >> p[2];
-                out.points.push_back(p);
-            } else if (tag == "f") {
-                std::vector<int> poly;
-                for (std::string w; words >> w;) poly.push_back(index(w));
-                for (size_t k = 1; k + 1 < poly.size(); ++k) out.triangles.push_back({poly[0], poly[k], poly[k + 1]});
-            } else if (tag == "l") {
-                std::vector<int> line;
-                for (std::string w; words >> w;) line.push_back(index(w));
-                out.polylines.push_back(std::move(line));
-            }
-        }
-        return true;
-    }
-    fields::PointSet ps;
-    if (fields::IoError e = fields::readPoints(path, ps)) {
-        error = e.render();
-        return false;
-    }
-    const int x = ps.find("x"), y = ps.find("y"), z = ps.find("z"), strand = ps.find("strand");
-    if (x < 0 || y < 0 || z < 0) {
-        error = path + ": no x, y, z columns";
-        return false;
-    }
-    for (size_t i = 0; i < ps.size(); ++i) out.points.push_back({ps.columns[x][i], ps.columns[y][i], ps.columns[z][i]});
-    for (const std::vector<int>& f : ps.faces)
-        for (size_t k = 1; k + 1 < f.size(); ++k) out.triangles.push_back({f[0], f[k], f[k + 1]});
-    if (strand >= 0)
-        for (size_t i = 0; i < ps.size(); ++i) {
-            if (i == 0 || ps.columns[strand][i] != ps.columns[strand][i - 1]) out.polylines.emplace_back();
-            out.polylines.back().push_back(static_cast<int>(i));
-        }
-    return true;
-}
-
 int runVizFrames(const VizOptions& o) {
     std::string error;
     if (!isSceneFile(o.source.file)) {
@@ -295,14 +243,15 @@ int runVizFrames(const VizOptions& o) {
     std::vector<long> frames;
     int normal = 2, width = 0, height = 0;
     double planeValue = 0.0;
-    ImageFormat format;
+    viz::ImageFormat format;
     std::string probe;
     if (!parseFrameList(o.frames, frames, error) || !parsePlane(o.plane, normal, planeValue, error) ||
         !parseSize(o.size, width, height, error)) {
         printError(error);
         return kExitUsage;
     }
-    if (!imageFormatFromPath(o.output, format) || !fields::framePath(o.output, frames.front(), probe)) {
+    if (!viz::imageFormatFromPath(o.output, format) ||
+        !io::framePath(o.output, frames.front(), probe)) {
         printError("-o '" + o.output + "': with --frames, name a .png or .svg with one run of # for the frame "
                    "number (preview.#.png)");
         return kExitUsage;
@@ -314,7 +263,7 @@ int runVizFrames(const VizOptions& o) {
     if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
     solver::SimScene sim;
     std::vector<fields::SceneError> errors;
-    if (!solver::loadSimScene(o.source.file, sim, errors, o.source.sets)) {
+    if (!gale::scene::loadSimScene(o.source.file, sim, errors, o.source.sets)) {
         for (const fields::SceneError& e : errors) std::cerr << e.render() << '\n';
         return kExitInput;
     }
@@ -326,12 +275,12 @@ int runVizFrames(const VizOptions& o) {
         return kExitInput;
     }
     const std::string dir = o.sim.empty() ? "sim" : o.sim;
-    std::map<long, std::vector<GeometryOverlay>> geometry;
-    std::vector<const GeometryOverlay*> all;
+    std::map<long, std::vector<viz::GeometryOverlay>> geometry;
+    std::vector<const viz::GeometryOverlay*> all;
     for (long f : frames) {
         for (const auto& [name, ext] : objects) {
-            GeometryOverlay g;
-            if (!loadFrameGeometry(framedName(dir, name, f, ext), g, error)) {
+            viz::GeometryOverlay g;
+            if (!viz::loadFrameGeometry(framedName(dir, name, f, ext), g, error)) {
                 printError(error);
                 return kExitIo;
             }
@@ -340,7 +289,7 @@ int runVizFrames(const VizOptions& o) {
         }
     }
     for (auto& [f, gs] : geometry)
-        for (const GeometryOverlay& g : gs) all.push_back(&g);
+        for (const viz::GeometryOverlay& g : gs) all.push_back(&g);
     std::array<double, 4> b{};
     if (!o.bounds.empty() ? !boundsFromFlag(o.bounds, b) : !geometryBounds(all, uAxis, vAxis, b)) {
         if (o.bounds.empty()) printError("the frames hold no finite points to frame; give --bounds");
@@ -349,15 +298,16 @@ int runVizFrames(const VizOptions& o) {
 
     for (long f : frames) {
         const double t = f / input.fps;
-        SliceOverlays overlays;
-        if (input.scene) overlays = sceneOverlays(*input.scene, t);
+        viz::SliceOverlays overlays;
+        if (input.scene) overlays = viz::sceneOverlays(*input.scene, t);
         overlays.geometry = geometry[f];
-        SliceLayout layout;
-        if (!layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present, layout)) {
+        viz::SliceLayout layout;
+        if (!viz::layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present,
+                              layout)) {
             printError("--size " + o.size + " is too small for a picture of these bounds");
             return kExitUsage;
         }
-        Slice slice;
+        viz::Slice slice;
         slice.nu = layout.plotW;
         slice.nv = layout.plotH;
         slice.bounds = b;
@@ -367,7 +317,7 @@ int runVizFrames(const VizOptions& o) {
         slice.planeValue = planeValue;
         if (!o.noField)
             if (int rc = sampleSlice(input, t, o.threads, slice)) return rc;
-        RenderSettings settings;
+        viz::RenderSettings settings;
         settings.format = format;
         settings.title = input.name + "   \u00b7   frame " + std::to_string(f);
         settings.subtitle = "view along " + std::string(1, "xyz"[normal]) +
@@ -375,17 +325,17 @@ int runVizFrames(const VizOptions& o) {
                                                              formatValue(planeValue, false) + " m") +
                             "   \u00b7   t = " + shortNumber(t) + " s at " + shortNumber(input.fps) + " fps";
         settings.time = t;
-        settings.style = o.style == "streamlines" ? FlowStyle::Streamlines
-                         : o.style == "none"      ? FlowStyle::None
-                                                  : FlowStyle::Arrows;
+        settings.style = o.style == "streamlines" ? viz::FlowStyle::Streamlines
+                         : o.style == "none"      ? viz::FlowStyle::None
+                                                  : viz::FlowStyle::Arrows;
         settings.speedMax = o.speedMax;
         settings.arrowSpacing = o.arrowSpacing;
         settings.fieldRaster = !o.noField;
         std::string path;
-        fields::framePath(o.output, f, path);
-        if (fields::IoError e = renderSlice(path, layout, slice, overlays, settings)) {
+        io::framePath(o.output, f, path);
+        if (io::IoError e = viz::renderSlice(path, layout, slice, overlays, settings)) {
             std::cerr << e.render() << '\n';
-            return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+            return e.kind == io::IoError::Io ? kExitIo : kExitInput;
         }
     }
     return kExitOk;
@@ -411,8 +361,8 @@ int runContactSheet(const VizOptions& o) {
         cellW = static_cast<int>(a[0]);
         cellH = static_cast<int>(c[0]);
     }
-    ImageFormat format;
-    if (!imageFormatFromPath(o.output, format) || format != ImageFormat::Png) {
+    viz::ImageFormat format;
+    if (!viz::imageFormatFromPath(o.output, format) || format != viz::ImageFormat::Png) {
         printError("-o '" + o.output + "': a contact sheet is a .png");
         return kExitUsage;
     }
@@ -457,7 +407,7 @@ int runContactSheet(const VizOptions& o) {
         return kExitUsage;
     }
 
-    ContactSheet sheet;
+    viz::ContactSheet sheet;
     sheet.title = "gale wedge " + o.contactSheet + "   \u00b7   " + std::to_string(variants.size()) + " variants";
     sheet.cellW = cellW;
     sheet.cellH = cellH;
@@ -467,8 +417,8 @@ int runContactSheet(const VizOptions& o) {
                                                    : std::vector<std::pair<std::string, Json>>{})
         keys.push_back(m.first);
     const std::vector<std::string> shortNames = shortKeyNames(keys);
-    std::vector<std::vector<std::vector<GeometryOverlay>>> geometry(variants.size());
-    std::vector<const GeometryOverlay*> all;
+    std::vector<std::vector<std::vector<viz::GeometryOverlay>>> geometry(variants.size());
+    std::vector<const viz::GeometryOverlay*> all;
     int missing = 0;
     for (size_t r = 0; r < variants.size(); ++r) {
         const Json& v = variants[r];
@@ -484,8 +434,10 @@ int runContactSheet(const VizOptions& o) {
         for (size_t c = 0; c < frames.size(); ++c) {
             if (const Json* objs = v.get("objects"))
                 for (const Json& ob : objs->items) {
-                    GeometryOverlay g;
-                    if (loadFrameGeometry(framedName(dir, ob.str("name"), frames[c], ob.str("format")), g, error)) {
+                    viz::GeometryOverlay g;
+                    if (viz::loadFrameGeometry(
+                            framedName(dir, ob.str("name"), frames[c], ob.str("format")), g,
+                            error)) {
                         g.label = ob.str("name");
                         geometry[r][c].push_back(std::move(g));
                     } else {
@@ -496,7 +448,7 @@ int runContactSheet(const VizOptions& o) {
     }
     for (auto& row : geometry)
         for (auto& cell : row)
-            for (const GeometryOverlay& g : cell) all.push_back(&g);
+            for (const viz::GeometryOverlay& g : cell) all.push_back(&g);
     if (all.empty()) {
         printError(o.contactSheet + ": none of the variants has those frames yet (run the wedge first)");
         return kExitIo;
@@ -508,9 +460,9 @@ int runContactSheet(const VizOptions& o) {
         return kExitUsage;
     }
     for (size_t r = 0; r < variants.size(); ++r) {
-        std::vector<ContactCell> row;
+        std::vector<viz::ContactCell> row;
         for (size_t c = 0; c < frames.size(); ++c) {
-            ContactCell cell;
+            viz::ContactCell cell;
             cell.slice.bounds = b;
             cell.slice.uAxis = uAxis;
             cell.slice.vAxis = vAxis;
@@ -523,9 +475,9 @@ int runContactSheet(const VizOptions& o) {
         }
         sheet.rows.push_back(std::move(row));
     }
-    if (fields::IoError e = renderContactSheet(o.output, sheet)) {
+    if (io::IoError e = viz::renderContactSheet(o.output, sheet)) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+        return e.kind == io::IoError::Io ? kExitIo : kExitInput;
     }
     return kExitOk;
 }

@@ -6,8 +6,9 @@
 
 #include "cli/commands.h"
 #include "cli/field_input.h"
-#include "cli/render.h"
 #include "fields/scene.h"
+#include "viz/overlays.h"
+#include "viz/picture.h"
 
 #include <string>
 #include <vector>
@@ -22,20 +23,14 @@ bool parseSize(const std::string& text, int& w, int& h, std::string& error);
 // Up to 3 decimals without trailing zeros: 28.8, 24, 0.125.
 std::string shortNumber(double v);
 std::string axisName(int a);
-// The windicator, gust bands and gust timeline of a scene at time t.
-SliceOverlays sceneOverlays(const fields::Scene& scene, double t);
 // Samples the wind at every pixel of `slice` (nu, nv, bounds, axes and plane set) at time t.
 // Prints the problem and returns an exit code (0 on success; 4 for non-finite velocities).
-int sampleSlice(const FieldInput& input, double t, int threads, Slice& slice);
+int sampleSlice(const FieldInput& input, double t, int threads, viz::Slice& slice);
 
 // ---- preview renders ----
 // Frames named by --frames: "A:B", "A:B:STEP" or a list "12,24,48" (ascending, no repeats
 // needed). False with `error` set otherwise.
 bool parseFrameList(const std::string& text, std::vector<long>& out, std::string& error);
-
-// One object's frame as written by gale sim (OBJ with f / l lines, or PLY with faces or a
-// `strand` column) as geometry to draw. False with `error` set when it cannot be read.
-bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::string& error);
 
 int runVizFrames(const VizOptions& options);
 int runContactSheet(const VizOptions& options);

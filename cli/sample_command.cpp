@@ -4,7 +4,7 @@
 #include "cli/common.h"
 #include "cli/field_input.h"
 #include "fields/grid_sample.h"
-#include "fields/vdb_io.h"
+#include "geometry/vdb_io.h"
 
 #include <CLI/CLI.hpp>
 
@@ -21,16 +21,16 @@ namespace gale::cli {
 namespace {
 
 // The output format: --format, else the -o extension, else CSV on stdout.
-bool chooseFormat(const SampleOptions& o, fields::GridFormat& format) {
+bool chooseFormat(const SampleOptions& o, io::GridFormat& format) {
     if (o.format == "vdb")
-        format = fields::GridFormat::Vdb;
+        format = io::GridFormat::Vdb;
     else if (o.format == "npy")
-        format = fields::GridFormat::Npy;
+        format = io::GridFormat::Npy;
     else if (o.format == "csv")
-        format = fields::GridFormat::Csv;
+        format = io::GridFormat::Csv;
     else if (o.output.empty() || o.output == "-")
-        format = fields::GridFormat::Csv;
-    else if (!fields::gridFormatFromPath(o.output, format)) {
+        format = io::GridFormat::Csv;
+    else if (!io::gridFormatFromPath(o.output, format)) {
         printError("cannot tell the output format from '" + o.output +
                    "': use a .vdb, .npy or .csv name, or --format");
         return false;
@@ -64,13 +64,12 @@ private:
     bool mShown = false;
 };
 
-int writeOutput(const SampleOptions& o, const std::string& path, fields::GridFormat format,
-                const fields::GridSpec& grid, const std::vector<float>& values,
-                const FieldInput& input, double t, double frame) {
+int writeOutput(const SampleOptions& o, const std::string& path, io::GridFormat format,
+                const io::GridSpec& grid, const std::vector<float>& values, const FieldInput& input,
+                double t, double frame) {
     if (path.empty() || path == "-") {
-        fields::IoError e = format == fields::GridFormat::Npy
-                                ? fields::writeGridNpy(std::cout, grid, values)
-                                : fields::writeGridCsv(std::cout, grid, values);
+        io::IoError e = format == io::GridFormat::Npy ? io::writeGridNpy(std::cout, grid, values)
+                                                      : io::writeGridCsv(std::cout, grid, values);
         std::cout.flush();
         if (e || !std::cout) {
             printError("cannot write to stdout" + (e ? ": " + e.message : std::string()));
@@ -78,20 +77,20 @@ int writeOutput(const SampleOptions& o, const std::string& path, fields::GridFor
         }
         return kExitOk;
     }
-    fields::IoError e;
-    if (format == fields::GridFormat::Vdb) {
-        fields::VdbWriteOptions vdb;
+    io::IoError e;
+    if (format == io::GridFormat::Vdb) {
+        geometry::VdbWriteOptions vdb;
         vdb.metadata["gale_source"] = input.name;
         vdb.floatMetadata["gale_time"] = t;
         vdb.floatMetadata["gale_frame"] = frame;
         vdb.floatMetadata["gale_fps"] = input.fps;
-        e = fields::writeVdbVelocity(path, grid, values, vdb);
+        e = geometry::writeVdbVelocity(path, grid, values, vdb);
     } else {
-        e = fields::writeGridFile(path, format, grid, values);
+        e = io::writeGridFile(path, format, grid, values);
     }
     if (e) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+        return e.kind == io::IoError::Io ? kExitIo : kExitInput;
     }
     return kExitOk;
 }
@@ -106,13 +105,14 @@ void removeStaleFrameTemps(const std::string& pattern) {
     if (first == std::string::npos || folder.find('#') != std::string::npos) return;
     const size_t end = name.find_first_not_of('#', first);
     const std::string head = name.substr(0, first), tail = end == std::string::npos ? "" : name.substr(end);
-    fields::removeStaleTempFiles(folder, [&](const std::string& target) {
+    io::removeStaleTempFiles(folder, [&](const std::string& target) {
         if (target.size() <= head.size() + tail.size() || target.compare(0, head.size(), head) != 0 ||
             target.compare(target.size() - tail.size(), tail.size(), tail) != 0)
             return false;
         const std::string middle = target.substr(head.size(), target.size() - head.size() - tail.size());
         for (size_t i = 0; i < middle.size(); ++i)
-            if (!std::isdigit(static_cast<unsigned char>(middle[i])) && !(i == 0 && middle[i] == '-')) return false;
+            if (!std::isdigit(static_cast<unsigned char>(middle[i])) && !(i == 0 && middle[i] == '-'))
+                return false;
         return true;
     });
 }
@@ -159,17 +159,17 @@ int runSample(const SampleOptions& o) {
         printError("--time must be a finite number of seconds");
         return kExitUsage;
     }
-    fields::GridSpec grid;
+    io::GridSpec grid;
     const std::array<double, 6> box{bounds[0], bounds[1], bounds[2],
                                     bounds[3], bounds[4], bounds[5]};
-    if (!fields::gridFromBounds(box, res, o.voxel, grid, error)) {
+    if (!io::gridFromBounds(box, res, o.voxel, grid, error)) {
         printError(error);
         return kExitUsage;
     }
-    fields::GridFormat format;
+    io::GridFormat format;
     if (!chooseFormat(o, format)) return kExitUsage;
     const bool toStdout = o.output.empty() || o.output == "-";
-    if (format == fields::GridFormat::Vdb && toStdout) {
+    if (format == io::GridFormat::Vdb && toStdout) {
         printError("a .vdb grid is written to a file: give -o OUT.vdb");
         return kExitUsage;
     }
@@ -181,7 +181,7 @@ int runSample(const SampleOptions& o) {
             printError(error);
             return kExitUsage;
         }
-        if (toStdout || !fields::framePath(o.output, firstFrame, probe)) {
+        if (toStdout || !io::framePath(o.output, firstFrame, probe)) {
             printError("--frames writes one file per frame: give -o with one run of '#' for the "
                        "frame number (wind.#.vdb -> wind.0001.vdb)");
             return kExitUsage;
@@ -209,7 +209,7 @@ int runSample(const SampleOptions& o) {
             // Frames are written whole or not at all (temporary name, then rename), so a frame
             // file on disk is complete (an empty one, left by a crash of the machine, is redone).
             std::string path;
-            fields::framePath(o.output, f, path);
+            io::framePath(o.output, f, path);
             std::error_code ec;
             if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) > 0 && !ec) {
                 ++skipped;
@@ -244,7 +244,7 @@ int runSample(const SampleOptions& o) {
             return kExitNumeric;
         }
         std::string path = o.output;
-        if (frames) fields::framePath(o.output, f, path);
+        if (frames) io::framePath(o.output, f, path);
         if (int rc = writeOutput(o, path, format, grid, values, input, when.time, frameNumber))
             return rc;
     }

@@ -6,6 +6,7 @@
 
 #include "fields/atomic_file.h"
 #include "fields/expression_field.h"
+#include "scene/load.h"
 #include "solver/scene.h"
 
 #include <CLI/CLI.hpp>
@@ -302,7 +303,7 @@ int runSim(const SimOptions& o) {
     // The scene: wind and solver sections, then the field and the bodies.
     solver::SimScene scene;
     std::vector<fields::SceneError> errors;
-    const bool loaded = solver::loadSimScene(o.scene, scene, errors, o.sets);
+    const bool loaded = gale::scene::loadSimScene(o.scene, scene, errors, o.sets);
     auto report = [&](const std::vector<fields::SceneError>& es) {
         bool io = false;
         for (const fields::SceneError& e : es) {

@@ -4,9 +4,9 @@
 #include "cli/common.h"
 #include "cli/field_input.h"
 #include "cli/preview.h"
-#include "cli/render.h"
 #include "fields/grid_sample.h"
 #include "fields/rigs.h"
+#include "viz/cairo_render.h"
 
 #include <CLI/CLI.hpp>
 
@@ -75,68 +75,7 @@ std::string axisName(int a) {
     return std::string(1, static_cast<char>('x' + a));
 }
 
-// Samples of a gust's strength * envelope at the origin plane, from just before its start to
-// just after it has died away.
-static TimelineOverlay::Curve gustCurve(const fields::Gust& g, const std::string& label) {
-    TimelineOverlay::Curve c;
-    c.label = label;
-    const double total = g.attack + g.hold + g.decay;
-    const int n = 96;
-    for (int i = 0; i <= n; ++i) {
-        const double tau = total * i / n;
-        const double t = g.start + tau;
-        // At tau = total the envelope is back to 0; at 0 it starts from 0.
-        c.points.push_back(
-            {t, g.strength.scalarAt(t) * fields::gustEnvelope(g, std::min(tau, total - 1e-12))});
-    }
-    c.points.front()[1] = 0.0;
-    c.points.back()[1] = 0.0;
-    return c;
-}
-
-SliceOverlays sceneOverlays(const fields::Scene& scene, double t) {
-    SliceOverlays o;
-    const fields::Windicator w = scene.windicator.value_or(fields::Windicator{});
-    const fields::Vec3 dir = fields::windDirectionAt(w, t);
-    if (scene.windicator) {
-        o.windicator.present = true;
-        o.windicator.direction = {dir[0], dir[1], dir[2]};
-        o.windicator.speed = w.speed.scalarAt(t);
-    }
-    TimelineOverlay& tl = o.timeline;
-    const double fps = scene.settings.fps > 0 ? scene.settings.fps : 24.0;
-    tl.sceneStart = scene.settings.frameStart / fps;
-    tl.sceneEnd = scene.settings.frameEnd / fps;
-    tl.t0 = std::min({tl.sceneStart, t, 0.0});
-    tl.t1 = std::max(tl.sceneEnd, t);
-    for (size_t i = 0; i < scene.gusts.size(); ++i) {
-        const fields::Gust& g = scene.gusts[i];
-        const std::string label = g.name.empty() ? "gust " + std::to_string(i + 1) : g.name;
-        tl.gusts.push_back(gustCurve(g, label));
-        tl.t0 = std::min(tl.t0, g.start);
-        tl.t1 = std::max(tl.t1, g.start + g.attack + g.hold + g.decay);
-        if (g.travelSpeed > 0 && (dir[0] != 0 || dir[1] != 0 || dir[2] != 0)) {
-            GustBand band;
-            band.label = label;
-            band.direction = {dir[0], dir[1], dir[2]};
-            band.front = (t - g.start) * g.travelSpeed;
-            band.tail = (t - g.start - (g.attack + g.hold + g.decay)) * g.travelSpeed;
-            o.gusts.push_back(band);
-        }
-    }
-    tl.present = !scene.gusts.empty() || (scene.windicator && w.speed.isKeyed());
-    if (scene.windicator) {
-        tl.windicatorSpeed.label = "windicator";
-        const int n = 240;
-        for (int i = 0; i <= n; ++i) {
-            const double s = tl.t0 + (tl.t1 - tl.t0) * i / n;
-            tl.windicatorSpeed.points.push_back({s, w.speed.scalarAt(s)});
-        }
-    }
-    return o;
-}
-
-int sampleSlice(const FieldInput& input, double t, int threads, Slice& slice) {
+int sampleSlice(const FieldInput& input, double t, int threads, viz::Slice& slice) {
     const int uAxis = slice.uAxis, vAxis = slice.vAxis, normal = slice.normalAxis;
     const std::array<double, 4>& b = slice.bounds;
     const double planeValue = slice.planeValue;
@@ -208,8 +147,8 @@ int runViz(const VizOptions& o) {
         printError(error);
         return kExitUsage;
     }
-    ImageFormat format;
-    if (!imageFormatFromPath(o.output, format)) {
+    viz::ImageFormat format;
+    if (!viz::imageFormatFromPath(o.output, format)) {
         printError("cannot tell the picture format from '" + o.output +
                    "': use a .png or .svg name");
         return kExitUsage;
@@ -224,15 +163,16 @@ int runViz(const VizOptions& o) {
     FieldInput input;
     if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
     const double t = o.time;
-    SliceOverlays overlays;
-    if (input.scene) overlays = sceneOverlays(*input.scene, t);
+    viz::SliceOverlays overlays;
+    if (input.scene) overlays = viz::sceneOverlays(*input.scene, t);
 
-    SliceLayout layout;
-    if (!layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present, layout)) {
+    viz::SliceLayout layout;
+    if (!viz::layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present,
+                          layout)) {
         printError("--size " + o.size + " is too small for a picture of these bounds");
         return kExitUsage;
     }
-    Slice slice;
+    viz::Slice slice;
     slice.nu = layout.plotW;
     slice.nv = layout.plotH;
     slice.bounds = {b[0], b[1], b[2], b[3]};
@@ -242,22 +182,22 @@ int runViz(const VizOptions& o) {
     slice.planeValue = planeValue;
     if (int rc = sampleSlice(input, t, o.threads, slice)) return rc;
 
-    RenderSettings settings;
+    viz::RenderSettings settings;
     settings.format = format;
     settings.title = input.name;
     settings.subtitle = "slice " + axisName(normal) + " = " + formatValue(planeValue, false) +
                         " m   \u00b7   t = " + shortNumber(t) + " s (frame " +
                         shortNumber(t * input.fps) + " at " + shortNumber(input.fps) + " fps)";
     settings.time = t;
-    settings.style = o.style == "streamlines" ? FlowStyle::Streamlines
-                     : o.style == "none"      ? FlowStyle::None
-                                              : FlowStyle::Arrows;
+    settings.style = o.style == "streamlines" ? viz::FlowStyle::Streamlines
+                     : o.style == "none"      ? viz::FlowStyle::None
+                                              : viz::FlowStyle::Arrows;
     settings.speedMax = o.speedMax;
     settings.arrowSpacing = o.arrowSpacing;
-    fields::IoError e = renderSlice(o.output, layout, slice, overlays, settings);
+    io::IoError e = viz::renderSlice(o.output, layout, slice, overlays, settings);
     if (e) {
         std::cerr << e.render() << '\n';
-        return e.kind == fields::IoError::Io ? kExitIo : kExitInput;
+        return e.kind == io::IoError::Io ? kExitIo : kExitInput;
     }
     return kExitOk;
 }
@@ -265,9 +205,10 @@ int runViz(const VizOptions& o) {
 Command addVizCommand(CLI::App& app) {
     auto o = std::make_shared<VizOptions>();
     CLI::App* sub = app.add_subcommand(
-        "viz", "Draw a slice of the wind as a PNG or SVG picture: colour = speed (viridis, with "
-               "a legend in m/s), arrows or streamlines for the in-plane direction, and for "
-               "scenes the windicator arrow, gust fronts and a gust timeline.");
+        "viz",
+        "Draw a slice of the wind as a PNG or SVG picture: colour = speed (viz::viridis, with "
+        "a legend in m/s), arrows or streamlines for the in-plane direction, and for "
+        "scenes the windicator arrow, gust fronts and a gust timeline.");
     addSourceOptions(*sub, o->source, /*withType=*/false, /*scenes=*/true);
     sub->add_option("--plane", o->plane,
                     "The slice: z=C (drawn with x right, y up), y=C (x right, z up) or x=C (z "

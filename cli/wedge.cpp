@@ -4,7 +4,7 @@
 #include "cli/wedge.h"
 
 #include "cli/common.h"
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <signal.h>
 #include <spawn.h>
@@ -58,7 +58,7 @@ std::string jsonValue(const std::string& text) {
     const char* begin = text.c_str();
     char* end = nullptr;
     const double v = std::strtod(begin, &end);
-    if (!text.empty() && end == begin + text.size() && std::isfinite(v)) return fields::formatNumber(v);
+    if (!text.empty() && end == begin + text.size() && std::isfinite(v)) return io::formatNumber(v);
     return jsonString(text);
 }
 

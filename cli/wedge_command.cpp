@@ -5,7 +5,8 @@
 #include "cli/common.h"
 #include "cli/wedge.h"
 
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
+#include "scene/load.h"
 #include "solver/scene.h"
 
 #include <CLI/CLI.hpp>
@@ -98,7 +99,7 @@ int runWedge(const WedgeOptions& o) {
         v.sets = sets;
         solver::SimScene scene;
         std::vector<fields::SceneError> errors;
-        if (!solver::loadSimScene(o.scene, scene, errors, sets)) {
+        if (!gale::scene::loadSimScene(o.scene, scene, errors, sets)) {
             bool io = false;
             for (const fields::SceneError& e : errors) {
                 std::cerr << e.render() << '\n';

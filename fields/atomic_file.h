@@ -1,31 +1,16 @@
-// Files that are never half-written: written under a temporary name in the same folder, then
-// renamed over the target. Devices and pipes (/dev/null, a FIFO) are written in place, since a
-// rename would replace them; a symbolic link is followed so the link survives.
+// Transitional: atomic files and point sets moved to io/ (io/atomic_file.h, io/pointset.h,
+// namespace gale::io). This header keeps the old names for cli/sim_command.cpp until it
+// includes io/ itself; new code includes io/ directly. Remove it with that change.
 #pragma once
 
-#include "fields/pointset.h"
-
-#include <functional>
-#include <string>
-#include <vector>
+#include "io/atomic_file.h"
+#include "io/pointset.h"
 
 namespace gale::fields {
-
-// `write` fills the path it is given (the temporary file, or the device itself); on any error
-// the temporary file is removed and `path` is left untouched. A folder is an Io error.
-IoError writeFileAtomic(const std::string& path,
-                        const std::function<IoError(const std::string& tmpPath)>& write);
-
-// The same for a block of bytes already in memory.
-IoError writeBytesAtomic(const std::string& path, const std::string& bytes);
-
-// The temporary files that writes killed part-way (SIGKILL, a crash) left in `folder`:
-// `<target>.tmp.<pid>` where no process `pid` is running and `isOurs(target)` holds for the
-// target's file name. Removes them and returns their paths; files of running writers are kept.
-std::vector<std::string> removeStaleTempFiles(const std::string& folder,
-                                              const std::function<bool(const std::string& target)>& isOurs);
-
-// An Io error for `file`: "what: strerror(err)".
-IoError ioErrorAt(const std::string& file, const std::string& what, int err);
-
+using io::formatNumber;
+using io::IoError;
+using io::PointFormat;
+using io::removeStaleTempFiles;
+using io::writeBytesAtomic;
+using io::writePointsFile;
 } // namespace gale::fields

@@ -5,6 +5,7 @@
 
 #include "fields/presets.h"
 #include "fields/rigs.h"
+#include "geometry/builtins.h"
 #include "lang/lexer.h"
 
 #include <algorithm>
@@ -240,7 +241,8 @@ std::shared_ptr<ExpressionField> ExpressionField::compile(const lang::SourceFile
     settings.functions = options.functions     ? options.functions
                          : options.scene       ? sceneFunctions(*options.scene)
                                                : fieldFunctions();
-    if (options.files) settings.functions = withFileAccess(settings.functions, *options.files);
+    if (options.files)
+        settings.functions = geometry::withFileAccess(settings.functions, *options.files);
     field->mOptions.functions = settings.functions;
     const lang::SourceFile blanked = withoutParameters(source, field->mParameters);
     field->mProgram = runtime::Program::compile(blanked, settings, sink);
@@ -353,10 +355,14 @@ std::shared_ptr<const runtime::FunctionTable> fieldFunctions() {
         auto t = std::make_shared<runtime::FunctionTable>(*runtime::FunctionTable::standard());
         addGustBuiltins(*t);
         addTurbulenceBuiltins(*t);
-        addGeometryBuiltins(*t, FileAccess{});
+        geometry::addGeometryBuiltins(*t, geometry::FileAccess{});
         return std::shared_ptr<const runtime::FunctionTable>(std::move(t));
     }();
     return table;
+}
+
+std::shared_ptr<const runtime::FunctionTable> fieldFunctions(const geometry::FileAccess& access) {
+    return geometry::withFileAccess(fieldFunctions(), access);
 }
 
 // ---- Scenes ----
@@ -425,7 +431,8 @@ FieldPtr buildSceneField(const Scene& scene, runtime::Precision precision, std::
         ExpressionFieldOptions options;
         // Files named by the expression: relative to its file (the scene for inline text),
         // inside the scene's folder.
-        FileAccess files = fileAccessFor(exprPath.empty() ? scene.path : exprPath, allowPaths);
+        geometry::FileAccess files =
+            geometry::fileAccessFor(exprPath.empty() ? scene.path : exprPath, allowPaths);
         files.rootDir = scene.baseDir.empty() ? "." : scene.baseDir;
         options.files = files;
         options.params = params;

@@ -4,9 +4,9 @@
 #pragma once
 
 #include "fields/field.h"
-#include "fields/geometry_paths.h"
 #include "fields/keyframes.h"
 #include "fields/scene.h"
+#include "geometry/file_policy.h"
 #include "runtime/program.h"
 
 #include <map>
@@ -57,7 +57,7 @@ struct ExpressionFieldOptions {
     // Where file names in the expression (sdf("body.obj", ...), vdb(...)) resolve and which
     // folders they may reach: when set, the geometry built-ins of `functions` are rebound to it
     // (withFileAccess); unset, they resolve against the current folder.
-    std::optional<FileAccess> files;
+    std::optional<geometry::FileAccess> files;
 };
 
 class ExpressionField : public Field {
@@ -94,16 +94,12 @@ private:
 // expressions resolve against the current folder.
 std::shared_ptr<const runtime::FunctionTable> fieldFunctions();
 // The same with the geometry built-ins resolving file names under `access` (a new table).
-std::shared_ptr<const runtime::FunctionTable> fieldFunctions(const FileAccess& access);
-// A copy of `table` whose geometry built-ins resolve file names under `access`.
-std::shared_ptr<const runtime::FunctionTable>
-withFileAccess(const std::shared_ptr<const runtime::FunctionTable>& table, const FileAccess& access);
+std::shared_ptr<const runtime::FunctionTable> fieldFunctions(const geometry::FileAccess& access);
 
 // Registration of the field layer's built-ins (each defined in its own file).
 void addGustBuiltins(runtime::FunctionTable& t);       // rigs.cpp: gust(P)
 void addTurbulenceBuiltins(runtime::FunctionTable& t); // fftturb.cpp: fftturb, fftturb4
-// geometry_builtins.cpp: sdf, sdfgrad, shadow, vdb, meshvel (docs/geometry.md)
-void addGeometryBuiltins(runtime::FunctionTable& t, const FileAccess& access);
+// sdf, sdfgrad, shadow, vdb, meshvel: geometry/builtins.h (addGeometryBuiltins, withFileAccess)
 
 // The expression of a [[field]] entry (its file, preset or inline source) as a SourceFile.
 // Inline text held verbatim in the scene is placed at its line and column in a file named after

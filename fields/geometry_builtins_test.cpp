@@ -2,9 +2,9 @@
 // and closed forms, meshvel() gives a translating sphere's velocity with its falloff, scenes
 // resolve names against their folder, and every misuse is a diagnostic at the argument's
 // file:line:col naming the file (missing, outside the folder, not constant, varying settings).
-#include "fields/test_support.h"
 #include "fields/expression_field.h"
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
+#include "io/test_support.h"
 #include "lang/diagnostics.h"
 
 #include <catch2/catch.hpp>
@@ -15,11 +15,12 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::geometry;
 namespace fs = std::filesystem;
 
 namespace {
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 struct Compiled {
     std::shared_ptr<ExpressionField> field;
@@ -210,34 +211,4 @@ TEST_CASE("geometry diagnostics point at the argument and name the file",
     CHECK(d.find("'interp' of 'vdb' must be a constant 0") != std::string::npos);
     // A uniform voxel (a parameter) is fine: the volume is built at evaluation.
     CHECK(shot("$res = 0.05;\nsdf(\"box.obj\", $P, $res)").empty());
-}
-
-TEST_CASE("a scene's expressions name files relative to their own file, inside the scene's "
-          "folder",
-          "[geometry][builtins]") {
-    TempDir dir;
-    fs::create_directories(dir.path / "wind");
-    REQUIRE_FALSE(writeTriangleMeshObj(dir.file("body.obj"), uvSphereMesh({0, 0, 0}, 0.5, 16, 32)));
-    std::ofstream(dir.file("wind/around.se")) << "[sdf(\"../body.obj\", $P), 0, 0]\n";
-    std::ofstream(dir.file("scene.toml"))
-        << "[[field]]\nname = \"a\"\nexpr = \"wind/around.se\"\n"
-           "[[field]]\nname = \"b\"\nsource = 'sdf(\"body.obj\", $P) * [0, 1, 0]'\n";
-    Scene scene;
-    std::vector<SceneError> errors;
-    REQUIRE(loadScene(dir.file("scene.toml"), scene, errors));
-    std::string report;
-    FieldPtr f = buildSceneField(scene, gale::runtime::Precision::Double, report);
-    INFO(report);
-    REQUIRE(f);
-    const std::vector<double> v = sampleAt(*f, {1.0, 0, 0});
-    CHECK(v[0] == Approx(0.5).margin(0.02));
-    CHECK(v[1] == Approx(0.5).margin(0.02));
-
-    // An inline source that leaves the scene's folder: an error at its line and column.
-    std::ofstream(dir.file("bad.toml"))
-        << "[[field]]\nname = \"a\"\nsource = 'sdf(\"../x.obj\", $P)'\n";
-    REQUIRE(loadScene(dir.file("bad.toml"), scene, errors));
-    report.clear();
-    CHECK_FALSE(buildSceneField(scene, gale::runtime::Precision::Double, report));
-    CHECK(report.find("bad.toml:3:15: error: '../x.obj' leads outside") != std::string::npos);
 }

@@ -2,10 +2,11 @@
 // quadratics exactly with quadratic interpolation, smooth fields within the trilinear error
 // bound; `gale sample`'s .vdb reads back identically at cell centres; `#` sequences blend
 // frames; missing, truncated, garbage and wrong-grid files are clear errors.
-#include "fields/test_support.h"
 #include "fields/expression_field.h"
-#include "fields/geometry.h"
-#include "fields/vdb_io.h"
+#include "fields/grid_sample.h"
+#include "geometry/geometry.h"
+#include "geometry/vdb_io.h"
+#include "io/test_support.h"
 #include "lang/diagnostics.h"
 
 #include <catch2/catch.hpp>
@@ -18,11 +19,13 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::geometry;
+using namespace gale::io;
 namespace fs = std::filesystem;
 
 namespace {
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 GridSpec testGrid() {
     GridSpec g;

@@ -1,58 +1,15 @@
-// Sampling a Field on a regular, cell-centred grid (what `gale sample` writes and `gale viz`
-// draws): grid geometry from bounds and a resolution or voxel size, batched multi-threaded
-// sampling into a float32 buffer, and the grid writers for .npy and .csv (atomic files).
+// Sampling a Field on a regular, cell-centred grid (io/grid.h) or at arbitrary points:
+// batched, multi-threaded sampling into float32 (grids) or double (points) buffers.
 #pragma once
 
 #include "fields/field.h"
-#include "fields/atomic_file.h"
-#include "fields/pointset.h"
+#include "io/grid.h"
 
-#include <array>
 #include <cstddef>
 #include <functional>
-#include <iosfwd>
-#include <string>
 #include <vector>
 
 namespace gale::fields {
-
-// A box of nx*ny*nz cells. Cell (i,j,k) covers [origin + (i,j,k)*voxel, origin + (i+1,j+1,k+1)
-// * voxel] and is sampled at its centre origin + (i+0.5, j+0.5, k+0.5) * voxel.
-struct GridSpec {
-    std::array<double, 3> origin{0.0, 0.0, 0.0}; // min corner of cell (0,0,0)
-    std::array<double, 3> voxel{1.0, 1.0, 1.0};  // cell size per axis (metres)
-    std::array<int, 3> res{1, 1, 1};             // cells per axis
-
-    size_t cellCount() const {
-        return static_cast<size_t>(res[0]) * static_cast<size_t>(res[1]) *
-               static_cast<size_t>(res[2]);
-    }
-    // Flat index of cell (i,j,k), x slowest: ((i*ny + j)*nz + k).
-    size_t index(int i, int j, int k) const {
-        return (static_cast<size_t>(i) * static_cast<size_t>(res[1]) + static_cast<size_t>(j)) *
-                   static_cast<size_t>(res[2]) +
-               static_cast<size_t>(k);
-    }
-    Vec3 cellCenter(int i, int j, int k) const {
-        return {origin[0] + (i + 0.5) * voxel[0], origin[1] + (j + 0.5) * voxel[1],
-                origin[2] + (k + 0.5) * voxel[2]};
-    }
-    // True when every cell has the same size on all three axes.
-    bool cubicVoxels() const { return voxel[0] == voxel[1] && voxel[1] == voxel[2]; }
-};
-
-// The largest grid the commands accept (cells); 12 bytes each in memory.
-constexpr size_t kMaxGridCells = size_t(1) << 30;
-
-// Grid over bounds {x0,y0,z0,x1,y1,z1} (x1 > x0 etc.), anchored at the min corner.
-//  - res = {N}: cubic voxels of size (longest side)/N; every other axis gets the fewest cells
-//    that cover it, ceil(length/voxel).
-//  - res = {NX,NY,NZ}: exactly those counts, voxel size length/count per axis.
-//  - voxel > 0 (with res empty): cubic voxels of that size, ceil(length/voxel) cells per axis
-//    (the last cell may reach past the max corner by less than one voxel).
-// False with `error` set (a sentence) on degenerate bounds, counts < 1, or too many cells.
-bool gridFromBounds(const std::array<double, 6>& bounds, const std::vector<int>& res, double voxel,
-                    GridSpec& out, std::string& error);
 
 struct GridSampleOptions {
     int threads = 0;     // 0: all hardware threads
@@ -71,27 +28,7 @@ SampleStatus samplePoints(const Field& field, const double* positions, size_t co
 // Samples `field` at every cell centre of `grid` into `out` (float32, resized to
 // 3 * cellCount, x slowest: out[3*grid.index(i,j,k) + c]). Velocities that are not finite
 // in double, or that overflow float32, are zero in `out` and counted in `nonFinite`.
-SampleStatus sampleGrid(const Field& field, const GridSpec& grid, const SampleTime& when,
+SampleStatus sampleGrid(const Field& field, const io::GridSpec& grid, const SampleTime& when,
                         std::vector<float>& out, const GridSampleOptions& options = {});
-
-// Writers for a sampled grid (`values` as sampleGrid leaves them).
-//  - npy: little-endian float32 array of shape (nx, ny, nz, 3), C order (x slowest).
-//  - csv: header `x,y,z,vx,vy,vz`, one row per cell in the same order; positions are the
-//    cell centres (shortest round-trip doubles), velocities shortest round-trip floats.
-enum class GridFormat { Vdb, Npy, Csv };
-// Format from a path's extension (.vdb .npy .csv, any case); false if none of them.
-bool gridFormatFromPath(const std::string& path, GridFormat& out);
-
-IoError writeGridNpy(std::ostream& out, const GridSpec& grid, const std::vector<float>& values);
-IoError writeGridCsv(std::ostream& out, const GridSpec& grid, const std::vector<float>& values);
-
-// npy or csv to a file, atomically.
-IoError writeGridFile(const std::string& path, GridFormat format, const GridSpec& grid,
-                      const std::vector<float>& values);
-
-// `pattern` with its one run of '#' replaced by the frame number, zero-padded to the run's
-// length, or to 4 digits for a single '#' (`wind.#.vdb` -> `wind.0012.vdb`, `v.##.npy` ->
-// `v.12.npy`, frame -3 -> `-0003`). False when the name has no '#' run or more than one.
-bool framePath(const std::string& pattern, long frame, std::string& out);
 
 } // namespace gale::fields

@@ -1,7 +1,7 @@
 // Tests for grid sampling: geometry from bounds, cell-centred values of an analytic field
 // (independent of threads and batch size), non-finite counting, the .npy and .csv grid
 // writers, atomic files and frame-numbered names.
-#include "fields/test_support.h"
+#include "io/test_support.h"
 #include "fields/grid_sample.h"
 
 #include <catch2/catch.hpp>
@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 using namespace gale::fields;
+using namespace gale::io;
 
 namespace {
 
@@ -59,7 +60,7 @@ public:
     std::string describe() const override { return "bad"; }
 };
 
-using test::TempDir;
+using gale::io::test::TempDir;
 
 float readFloatLE(const std::string& bytes, size_t at) {
     uint32_t u = 0;

@@ -1,6 +1,6 @@
-// A scene's wind description as loaded from TOML: settings, the windicator and gust rigs,
-// and the [[field]] entries. The solver's sections ([[cloth]], [[hair]], [[collider]]) are
-// described in solver/scene.h and parsed by the solver's loader through the same TOML file.
+// A scene's wind description: settings, the windicator and gust rigs, and the [[field]]
+// entries, as the scene loader (scene/load.h) reads them from TOML. The bodies' sections
+// ([[cloth]], [[hair]], [[collider]], [solver]) are described in solver/scene.h.
 #pragma once
 
 #include "fields/keyframes.h"
@@ -77,24 +77,5 @@ struct Scene {
     std::vector<Gust> gusts;
     std::vector<FieldEntry> fields;
 };
-
-} // namespace gale::fields
-
-namespace gale::fields {
-
-struct SceneLoadOptions {
-    // `--set KEY=VALUE` overrides by dotted path (`windicator.speed=12`, `field.main.params.swirl=0.3`,
-    // `scene.fps=30`); an unknown path is an error.
-    std::vector<std::string> sets;
-    // Top-level sections another layer parses (the solver passes "cloth", "hair", "collider");
-    // any other unknown key is an error.
-    std::vector<std::string> foreignSections{"cloth", "hair", "collider"};
-};
-
-// Reads and validates the wind part of a scene file. Errors carry file:line:col (toml++
-// source regions); every problem found is reported, not just the first. Returns false when
-// there were errors.
-bool loadScene(const std::string& path, Scene& out, std::vector<SceneError>& errors,
-               const SceneLoadOptions& options = {});
 
 } // namespace gale::fields

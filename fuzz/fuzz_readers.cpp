@@ -2,7 +2,7 @@
 // 0 CSV, 1 PLY (from memory), 2 OBJ point set, 3 OBJ mesh, 4 PLY mesh, 5 CSV strands (through a
 // temp file); the rest is the file. A point set read must be consistent and survive a PLY
 // round trip with the same shape; a mesh's triangles must index its vertices.
-#include "fields/pointset.h"
+#include "io/pointset.h"
 #include "solver/hair.h"
 #include "solver/mesh.h"
 
@@ -37,16 +37,16 @@ std::string writeTemp(const std::string& name, const std::string& bytes) {
     return path;
 }
 
-void checkPoints(const fields::PointSet& ps) {
+void checkPoints(const io::PointSet& ps) {
     if (ps.names.size() != ps.columns.size()) __builtin_trap();
     for (const auto& c : ps.columns)
         if (c.size() != ps.size()) __builtin_trap();
     if (ps.columns.empty() || ps.size() > 100000) return;
     // Written as binary PLY and read back: the same number of points and columns.
     std::stringstream ply;
-    if (fields::writePoints(ply, ps, fields::PointFormat::Ply)) return;
-    fields::PointSet back;
-    if (fields::IoError e = fields::readPointsPly(ply, "roundtrip.ply", back)) __builtin_trap();
+    if (io::writePoints(ply, ps, io::PointFormat::Ply)) return;
+    io::PointSet back;
+    if (io::IoError e = io::readPointsPly(ply, "roundtrip.ply", back)) __builtin_trap();
     if (back.size() != ps.size() || back.columns.size() != ps.columns.size()) __builtin_trap();
 }
 
@@ -66,21 +66,21 @@ void checkMesh(const solver::TriMesh& m) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size < 1 || size > 1 << 20) return 0;
     const std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
-    fields::PointSet ps;
+    io::PointSet ps;
     std::string error;
     switch (data[0] % 6) {
     case 0: {
         std::istringstream in(bytes);
-        if (!fields::readPointsCsv(in, "fuzz.csv", ps)) checkPoints(ps);
+        if (!io::readPointsCsv(in, "fuzz.csv", ps)) checkPoints(ps);
         break;
     }
     case 1: {
         std::istringstream in(bytes);
-        if (!fields::readPointsPly(in, "fuzz.ply", ps)) checkPoints(ps);
+        if (!io::readPointsPly(in, "fuzz.ply", ps)) checkPoints(ps);
         break;
     }
     case 2:
-        if (!fields::readPointsObj(writeTemp("points.obj", bytes), ps)) checkPoints(ps);
+        if (!io::readPointsObj(writeTemp("points.obj", bytes), ps)) checkPoints(ps);
         break;
     case 3:
     case 4: {

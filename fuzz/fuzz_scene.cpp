@@ -3,6 +3,7 @@
 // few points) and the bodies when small. No simulation step is run.
 #include "fields/expression_field.h"
 #include "fields/scene.h"
+#include "scene/load.h"
 #include "solver/scene.h"
 
 #include <unistd.h>
@@ -81,7 +82,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     solver::SimScene scene;
     std::vector<fields::SceneError> errors;
     ++gStats.inputs;
-    const bool loaded = solver::loadSimScene(path, scene, errors);
+    const bool loaded = gale::scene::loadSimScene(path, scene, errors);
     for (const fields::SceneError& e : errors) (void)e.render();
     if (loaded && !errors.empty()) __builtin_trap(); // success must not come with errors
     if (!loaded) {

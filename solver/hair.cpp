@@ -5,7 +5,7 @@
 // damping matrix D contributes D/4 to each of its four vertex blocks.
 #include "solver/hair.h"
 
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <cmath>
 
@@ -32,8 +32,8 @@ Strands makeStrandGrid(const Vec3& origin, double width, double depth, int nu, i
 }
 
 bool loadStrands(const std::string& path, Strands& out, std::string& error) {
-    fields::PointSet ps;
-    if (fields::IoError e = fields::readPoints(path, ps)) {
+    io::PointSet ps;
+    if (io::IoError e = io::readPoints(path, ps)) {
         error = e.render();
         return false;
     }

@@ -1,7 +1,7 @@
 // Mesh generation, loading through the fields layer's point-set readers, and topology.
 #include "solver/mesh.h"
 
-#include "fields/pointset.h"
+#include "io/pointset.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,8 +41,8 @@ TriMesh makeGrid(double width, double height, int nx, int ny, const Vec3& origin
 }
 
 bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dropped) {
-    fields::PointSet ps;
-    fields::IoError e = fields::readPoints(path, ps);
+    io::PointSet ps;
+    io::IoError e = io::readPoints(path, ps);
     if (e) {
         error = e.render();
         return false;

@@ -1,17 +1,17 @@
 // Mesh colliders: the SDF from the geometry cache, queried one vertex at a time.
 #include "solver/mesh_collider.h"
 
-#include "fields/geometry_cache.h"
-#include "fields/geometry_paths.h"
+#include "geometry/cache.h"
+#include "geometry/file_policy.h"
 
 namespace gale::solver {
 
 std::shared_ptr<const MeshCollider> MeshCollider::load(const std::string& path, double voxel,
                                                        std::string& error) {
-    fields::FrameFile file;
-    if (!fields::frameFileFor(path, file, error)) return nullptr;
-    std::shared_ptr<const fields::SdfVolume> sdf;
-    if (fields::IoError e = fields::cachedSdf(file, voxel, sdf)) {
+    geometry::FrameFile file;
+    if (!geometry::frameFileFor(path, file, error)) return nullptr;
+    std::shared_ptr<const geometry::SdfVolume> sdf;
+    if (io::IoError e = geometry::cachedSdf(file, voxel, sdf)) {
         error = "cannot use '" + path + "' as a collider: " + e.message;
         return nullptr;
     }

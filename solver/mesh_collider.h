@@ -1,9 +1,9 @@
 // Mesh colliders ([[collider]] type = "mesh"): a closed OBJ/PLY body as a narrow-band signed
-// distance volume (fields::SdfVolume, shared with sdf() through the geometry cache), queried
+// distance volume (geometry::SdfVolume, shared with sdf() through the geometry cache), queried
 // per vertex for the distance and the outward normal. The mesh is static.
 #pragma once
 
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 #include "solver/types.h"
 
 #include <memory>
@@ -13,7 +13,7 @@ namespace gale::solver {
 
 class MeshCollider {
 public:
-    explicit MeshCollider(std::shared_ptr<const fields::SdfVolume> sdf) : mSdf(std::move(sdf)) {}
+    explicit MeshCollider(std::shared_ptr<const geometry::SdfVolume> sdf) : mSdf(std::move(sdf)) {}
 
     // Loads `path` (a closed mesh) and builds its SDF at `voxel` metres (cached by file and
     // voxel). Null with `error` (a sentence naming the file) when it cannot be read or built.
@@ -24,10 +24,10 @@ public:
     // outward normal (the SDF's gradient).
     void query(const Vec3& x, double& distance, Vec3& normal) const;
 
-    const fields::SdfVolume& sdf() const { return *mSdf; }
+    const geometry::SdfVolume& sdf() const { return *mSdf; }
 
 private:
-    std::shared_ptr<const fields::SdfVolume> mSdf;
+    std::shared_ptr<const geometry::SdfVolume> mSdf;
 };
 
 } // namespace gale::solver

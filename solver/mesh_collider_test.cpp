@@ -1,7 +1,7 @@
 // Mesh colliders: the SDF of a box mesh against the analytic box distance and face normals,
 // the same through queryCollider, cloth draped over a mesh sphere staying outside it (within a
 // voxel), and the scene loader's [[collider]] type = "mesh" with its errors.
-#include "fields/geometry.h"
+#include "geometry/geometry.h"
 #include "solver/cloth.h"
 #include "solver/collider.h"
 #include "solver/mesh_collider.h"
@@ -41,9 +41,8 @@ double boxDistance(const Vec3& p, const Vec3& h) {
 TEST_CASE("mesh collider: distance and normal of a box mesh", "[collider][mesh]") {
     TempDir dir;
     const Vec3 h(0.3, 0.2, 0.25);
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(dir.file("box.obj"),
-                                                     gale::fields::boxMesh({-0.3, -0.2, -0.25},
-                                                                           {0.3, 0.2, 0.25})));
+    REQUIRE_FALSE(gale::geometry::writeTriangleMeshObj(
+        dir.file("box.obj"), gale::geometry::boxMesh({-0.3, -0.2, -0.25}, {0.3, 0.2, 0.25})));
     std::string error;
     const double voxel = 0.01;
     auto mesh = MeshCollider::load(dir.file("box.obj"), voxel, error);
@@ -80,8 +79,8 @@ TEST_CASE("mesh collider: distance and normal of a box mesh", "[collider][mesh]"
 
 TEST_CASE("mesh collider: cloth draped over a mesh sphere stays outside it", "[collider][mesh]") {
     TempDir dir;
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
-        dir.file("ball.obj"), gale::fields::uvSphereMesh({0, 0, 0}, 0.4, 24, 48)));
+    REQUIRE_FALSE(gale::geometry::writeTriangleMeshObj(
+        dir.file("ball.obj"), gale::geometry::uvSphereMesh({0, 0, 0}, 0.4, 24, 48)));
     std::string error;
     const double voxel = 0.02;
     auto ball = MeshCollider::load(dir.file("ball.obj"), voxel, error);
@@ -112,41 +111,4 @@ TEST_CASE("mesh collider: cloth draped over a mesh sphere stays outside it", "[c
     }
     CHECK(contacts > 10);
     CHECK(w.bodies()[0]->positions()[1] < 0.0); // the corners fell below the top
-}
-
-TEST_CASE("mesh collider in a scene: [[collider]] type = \"mesh\"", "[collider][mesh][scene]") {
-    TempDir dir;
-    REQUIRE_FALSE(gale::fields::writeTriangleMeshObj(
-        dir.file("body.obj"), gale::fields::boxMesh({-0.2, 0, -0.1}, {0.2, 1.6, 0.1})));
-    auto load = [&](const std::string& text, SimScene& scene, std::string& all) {
-        std::ofstream(dir.file("scene.toml")) << text;
-        std::vector<gale::fields::SceneError> errors;
-        const bool ok = loadSimScene(dir.file("scene.toml"), scene, errors);
-        all.clear();
-        for (const auto& e : errors) all += e.render() + "\n";
-        return ok;
-    };
-    SimScene scene;
-    std::string all;
-    REQUIRE(load("[[collider]]\nname = \"body\"\ntype = \"mesh\"\nmesh = \"body.obj\"\n"
-                 "voxel = 0.02\nthickness = 0.005\n",
-                 scene, all));
-    INFO(all);
-    REQUIRE(scene.colliders.size() == 1);
-    CHECK(scene.colliders[0].shape == ColliderShape::Mesh);
-    REQUIRE(scene.colliders[0].mesh);
-    CHECK(scene.colliders[0].mesh->sdf().voxel() == 0.02);
-    const ContactPoint cp = queryCollider(colliderPose(scene.colliders[0], 0.0), Vec3(0.5, 1, 0));
-    CHECK(cp.distance == Approx(0.3).margin(0.02));
-
-    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"nobody.obj\"\n", scene, all));
-    CHECK(all.find("scene.toml:3:8: error: [[collider]] 'collider0': cannot read") !=
-          std::string::npos);
-    CHECK(all.find("nobody.obj") != std::string::npos);
-    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\n", scene, all));
-    CHECK(all.find("a mesh collider needs 'mesh'") != std::string::npos);
-    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"body.obj\"\nradius = 1\n", scene, all));
-    CHECK(all.find("'radius' does not apply to a mesh collider") != std::string::npos);
-    CHECK_FALSE(load("[[collider]]\ntype = \"mesh\"\nmesh = \"body.obj\"\nvoxel = 0\n", scene, all));
-    CHECK(all.find("voxel") != std::string::npos);
 }

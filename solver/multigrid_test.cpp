@@ -195,35 +195,6 @@ TEST_CASE("multigrid: single-precision products, checked and reported in double"
     }
 }
 
-TEST_CASE("multigrid: the scene key picks the preconditioner; a bad value is an error at file:line:col",
-          "[multigrid][scene]") {
-    char tmpl[] = "/tmp/gale_multigrid_scene_XXXXXX";
-    const int fd = mkstemp(tmpl);
-    REQUIRE(fd >= 0);
-    close(fd);
-    const std::string path = tmpl;
-    auto load = [&](const std::string& value, SimScene& scene, std::string& errors) {
-        std::ofstream(path) << "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n"
-                            << (value.empty() ? "" : "preconditioner = " + value + "\n");
-        std::vector<gale::fields::SceneError> errs;
-        const bool ok = loadSimScene(path, scene, errs, {});
-        for (const auto& e : errs) errors += e.render() + "\n";
-        return ok;
-    };
-    SimScene a, b, c, d;
-    std::string ea, eb, ec, ed;
-    REQUIRE(load("", a, ea));
-    CHECK(a.cloths[0].step.preconditioner == Preconditioner::Multigrid); // the default
-    REQUIRE(load("\"multigrid\"", b, eb));
-    CHECK(b.cloths[0].step.preconditioner == Preconditioner::Multigrid);
-    REQUIRE(load("\"jacobi\"", d, ed));
-    CHECK(d.cloths[0].step.preconditioner == Preconditioner::BlockJacobi);
-    CHECK_FALSE(load("\"amg\"", c, ec));
-    INFO(ec);
-    CHECK(ec.find(path + ":4:18: error: unknown preconditioner 'amg'") != std::string::npos);
-    std::remove(path.c_str());
-}
-
 TEST_CASE("multigrid: PCG gives the same bits on 1, 2 and 3 threads", "[multigrid]") {
     // parallelRows 0: every level sweeps colour by colour in parallel chunks (on more than one
     // thread); the default sweeps the small coarse levels sequentially. All the same bits.

@@ -1,10 +1,10 @@
-// The solver's part of a scene file — [[cloth]], [[hair]], [[collider]] and [solver] — read
-// with toml++ beside fields::loadScene's wind part (one file, one set of --set overrides), and
-// turned into bodies: meshes and strands loaded, painted maps evaluated, pins resolved.
+// The solver's part of a scene — [[cloth]], [[hair]], [[collider]] and [solver] — as the scene
+// loader (scene/load.h) reads it from the same TOML file as the wind, and turned into bodies
+// here: meshes and strands loaded, painted maps evaluated, pins resolved.
 #pragma once
 
-#include "fields/pointset.h"
 #include "fields/scene.h"
+#include "io/pointset.h"
 #include "solver/cloth.h"
 #include "solver/hair.h"
 #include "solver/world.h"
@@ -84,13 +84,6 @@ struct SimScene {
     std::vector<Collider> colliders;
 };
 
-// Reads the whole scene: the wind part through fields::loadScene, the solver's sections here.
-// `sets` are `--set KEY=VALUE` overrides by dotted path (`cloth.cape.drag=0.8`,
-// `collider.0.radius=0.4`, `solver.max_halvings=4`, and the wind's own paths). Every problem
-// is reported at file:line:col; false when there were errors.
-bool loadSimScene(const std::string& path, SimScene& out, std::vector<fields::SceneError>& errors,
-                  const std::vector<std::string>& sets = {});
-
 // Loads meshes and strands, evaluates painted maps and pins, and makes the bodies. Problems
 // (a missing mesh, an unknown map, an expression error) come back as errors at the place in
 // the scene that named them; `warnings` gets notes such as degenerate-triangle counts. Files
@@ -106,6 +99,6 @@ WorldSettings worldSettings(const SimScene& scene, int threads);
 // A body's current shape for output: OBJ text (`v` lines, then `f` for cloth or `l` for
 // strands), or a point set with faces (cloth) or a `strand` column (hair) for PLY.
 std::string bodyObjText(const Body& body);
-fields::PointSet bodyPointSet(const Body& body);
+io::PointSet bodyPointSet(const Body& body);
 
 } // namespace gale::solver

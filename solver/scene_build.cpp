@@ -80,8 +80,8 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     settings.wantWidth = 1;
     // File names (sdf("body.obj", ...)) resolve against the map's file (the scene for inline
     // text) and stay inside the scene's folder, as in the wind's expressions.
-    fields::FileAccess files =
-        fields::fileAccessFor(spec.exprPath.empty() ? scene.wind.path : spec.exprPath, allowPaths);
+    geometry::FileAccess files = geometry::fileAccessFor(
+        spec.exprPath.empty() ? scene.wind.path : spec.exprPath, allowPaths);
     files.rootDir = scene.wind.baseDir.empty() ? "." : scene.wind.baseDir;
     settings.functions = fields::fieldFunctions(files);
     lang::DiagnosticSink sink;
@@ -338,8 +338,8 @@ std::string bodyObjText(const Body& body) {
     return out;
 }
 
-fields::PointSet bodyPointSet(const Body& body) {
-    fields::PointSet ps;
+io::PointSet bodyPointSet(const Body& body) {
+    io::PointSet ps;
     const VecX& x = body.positions();
     const VecX& v = body.velocities();
     const char* names[6] = {"x", "y", "z", "vx", "vy", "vz"};
