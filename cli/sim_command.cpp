@@ -4,7 +4,8 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 
-#include "fields/atomic_file.h"
+#include "io/atomic_file.h"
+#include "io/pointset.h"
 #include "fields/expression_field.h"
 #include "scene/load.h"
 #include "solver/scene.h"
@@ -33,7 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 using solver::Body;
 
-std::string num(double v) { return std::isfinite(v) ? fields::formatNumber(v) : "null"; }
+std::string num(double v) { return std::isfinite(v) ? io::formatNumber(v) : "null"; }
 
 std::string vec(const std::vector<double>& v) {
     std::string s = "[";
@@ -185,7 +186,7 @@ bool readFile(const std::string& path, std::string& out) {
 }
 
 int writeBytes(const std::string& path, const std::string& bytes) {
-    if (fields::IoError e = fields::writeBytesAtomic(path, bytes)) {
+    if (io::IoError e = io::writeBytesAtomic(path, bytes)) {
         printError(e.render());
         return kExitIo;
     }
@@ -202,7 +203,7 @@ int writeFrame(const solver::SimScene& sc, const solver::World& w, const std::st
         const std::string format = formatOf(bi++);
         const std::string path = frameFile(dir, b->name(), frame, format);
         if (format == "ply") {
-            if (fields::IoError e = fields::writePointsFile(path, solver::bodyPointSet(*b), fields::PointFormat::Ply)) {
+            if (io::IoError e = io::writePointsFile(path, solver::bodyPointSet(*b), io::PointFormat::Ply)) {
                 printError(e.render());
                 return kExitIo;
             }
@@ -250,14 +251,14 @@ void removeStaleTemps(const std::string& dir, const solver::World& w) {
         const size_t n = std::strlen(tail);
         return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
     };
-    fields::removeStaleTempFiles(dir, [&](const std::string& target) {
+    io::removeStaleTempFiles(dir, [&](const std::string& target) {
         if (target == "run.json") return true;
         if (!endsWith(target, ".obj") && !endsWith(target, ".ply")) return false;
         for (const std::string& n : names)
             if (target.compare(0, n.size(), n) == 0) return true;
         return false;
     });
-    fields::removeStaleTempFiles((fs::path(dir) / ".state").string(), [](const std::string&) { return true; });
+    io::removeStaleTempFiles((fs::path(dir) / ".state").string(), [](const std::string&) { return true; });
 }
 
 class Progress {
