@@ -119,13 +119,15 @@ double Body::elasticEnergy(double t) {
     return out.elasticEnergy;
 }
 
-double Body::maxEdgeStretch() const {
+double Body::maxEdgeStretch() const { return maxEdgeStretchOf(mX); }
+
+double Body::maxEdgeStretchOf(const VecX& x) const {
     double m = 0.0;
     for (size_t e = 0; e < mEdges.size(); ++e) {
         if (!(mEdgeRest[e] > 0.0)) continue;
-        const double len =
-            (vec3At(mX.data(), mEdges[e][1]) - vec3At(mX.data(), mEdges[e][0])).norm();
-        m = std::max(m, len / mEdgeRest[e]);
+        const double r = (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
+        if (std::isnan(r)) return r; // a non-finite state is never "not stretched"
+        m = std::max(m, r);
     }
     return m;
 }
@@ -222,14 +224,21 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
     return count;
 }
 
+namespace {
+// s = Σ of x over an element's corners (unused corners are −1).
+Vec3 cornerSum(const AeroCoupling& c, const VecX& x) {
+    Vec3 sum = Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+        if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
+    return sum;
+}
+} // namespace
+
 void Body::skewProduct(const VecX& x, VecX& y) const {
     y.setZero(x.size());
     for (const AeroCoupling& c : mAero) {
         if (c.v[0] < 0) continue;
-        Vec3 sum = Vec3::Zero();
-        for (int k = 0; k < 3; ++k)
-            if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
-        const Vec3 w = c.axis.cross(sum);
+        const Vec3 w = c.axis.cross(cornerSum(c, x));
         for (int k = 0; k < 3; ++k)
             if (c.v[k] >= 0) y.segment<3>(3 * c.v[k]) += w;
     }
@@ -239,9 +248,7 @@ double Body::aeroQuadratic(const VecX& x) const {
     double q = 0.0;
     for (const AeroCoupling& c : mAero) {
         if (c.v[0] < 0) continue;
-        Vec3 sum = Vec3::Zero();
-        for (int k = 0; k < 3; ++k)
-            if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
+        const Vec3 sum = cornerSum(c, x);
         q += sum.dot(c.damping * sum); // Σ_c x_cᵀ D s = sᵀ D s
     }
     return q;
@@ -388,13 +395,7 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
 bool Body::stretchFeasible(const VecX& x) const {
     // The over-stretch detector's rule (substep()): trouble when an edge exceeds the limit and
     // the largest stretch grew by more than 5 %. The line search takes no step into it.
-    const double cap = std::max(mLimits.overStretch, 1.05 * mStretchBefore);
-    for (size_t e = 0; e < mEdges.size(); ++e) {
-        if (!(mEdgeRest[e] > 0.0)) continue;
-        const double len = (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm();
-        if (!(len <= cap * mEdgeRest[e])) return false;
-    }
-    return true;
+    return maxEdgeStretchOf(x) <= std::max(mLimits.overStretch, 1.05 * mStretchBefore);
 }
 
 double Body::elasticAt(const VecX& x, double t, VecX& fEl) {
@@ -476,7 +477,6 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         }
         if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
             mDv = dvBase;
-            elasticAt(x0 + h * v0, t1, mFel);
             energy = elasticAt(x0 + h * v0, t1, mFel);
             break;
         }

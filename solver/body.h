@@ -173,6 +173,7 @@ public:
     double potentialEnergy(const Vec3& gravity) const; // −Σ m g·x (J)
     double elasticEnergy(double t);                    // J, at the current positions
     double maxEdgeStretch() const;                     // max |e| / |e_rest|
+    double maxEdgeStretchOf(const VecX& x) const;      // the same at positions x (NaN if any is)
     const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
 
 protected:
