@@ -526,6 +526,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         }
     }
     st.newtonResidual = rInf;
+    st.newtonStalled = !(rInf <= mOptions.newtonTolerance);
 }
 
 int Body::recover(const Snapshot& start, double h) {

@@ -99,6 +99,8 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
         stats.newtonIterations += st.newtonIterations;
         stats.maxNewtonIterations = std::max(stats.maxNewtonIterations, st.newtonIterations);
         stats.lineSearchCuts += st.lineSearchCuts;
+        stats.maxNewtonResidual = std::max(stats.maxNewtonResidual, st.newtonResidual);
+        if (st.newtonStalled) ++stats.newtonStalled;
         if (st.windNonFinite) {
             if (stats.windNonFinite == 0) {
                 std::snprintf(buf, sizeof buf, "t=%.6g s: wind: %s", t, st.windMessage.c_str());
