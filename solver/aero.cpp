@@ -120,6 +120,27 @@ Mat3 aeroTriangleExactJacobian(const Vec3& vRel, const Vec3& areaNormal, double 
     return k * j;
 }
 
+Mat3 aeroTriangleAreaJacobian(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
+                              double cd, AeroModel model) {
+    // F = ½ρ((C_D − C_L)|p| v + C_L r² σ a) (frozen), ½ρ(C_D |p| v + C_L(r p a/A − p² v/(A r)))
+    // (smooth-lift), differentiated in a at fixed v.
+    const double area = areaNormal.norm();
+    const double r2 = vRel.squaredNorm();
+    if (!(area > 0.0) || !std::isfinite(area) || !(r2 > 0.0)) return Mat3::Zero();
+    const double p = vRel.dot(areaNormal);
+    if (p == 0.0) return Mat3::Zero();
+    const double sigma = p > 0.0 ? 1.0 : -1.0;
+    const Mat3 I = Mat3::Identity();
+    const Mat3 vv = vRel * vRel.transpose();
+    if (model == AeroModel::Frozen) return 0.5 * rho * sigma * ((cd - cl) * vv + cl * r2 * I);
+    const double r = std::sqrt(r2);
+    const Vec3 ah = areaNormal / area;
+    const double s = std::abs(p) / area;
+    const Mat3 lift = r * ah * vRel.transpose() + (sigma * s * r) * (I - ah * ah.transpose()) -
+                      (2.0 * sigma * s / r) * vv + (s * s / r) * vRel * ah.transpose();
+    return 0.5 * rho * (cd * sigma * vv + cl * lift);
+}
+
 AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
                         double cd, AeroModel model, AeroJacobian jacobian) {
     AeroResult out;

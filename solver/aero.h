@@ -43,6 +43,18 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
 Mat3 aeroTriangleExactJacobian(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
                                double cd, AeroModel model);
 
+// ∂F/∂a of `aeroTriangle`'s force with respect to the area-weighted normal a = `areaNormal` at
+// fixed relative velocity: how the force turns and grows with the triangle's orientation, the
+// part of ∂F/∂x that the velocity damping lacks (Newton's full Jacobian, body.cpp). With
+// p = v·a, σ = sgn p, A = |a|, â = a/A, s = |p|/A, r = |v|:
+//   frozen:      ∂F/∂a = ½ρσ[(C_D − C_L) v vᵀ + C_L r² I]
+//   smooth-lift: ∂F/∂a = ½ρ[C_D σ v vᵀ + C_L(r â vᵀ + σ s r(I − â âᵀ) − 2σ(s/r) v vᵀ + (s²/r) v
+//   âᵀ)]
+// Zero at p = 0: there the frozen lift C_L r² n flips sides (F jumps by ρ C_L r² a), so the
+// backward-Euler equations of a triangle crossing edge-on have no solution (docs/solver.md).
+Mat3 aeroTriangleAreaJacobian(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
+                              double cd, AeroModel model);
+
 // The nearest (Frobenius) positive semi-definite matrix to the symmetric part of `j`, given
 // that j = c·I + (terms in span{n, v}); `n` unit, `v` any. Exact, closed form (2×2 eigen).
 Mat3 projectPsdInPlane(const Mat3& j, const Vec3& n, const Vec3& v);

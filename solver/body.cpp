@@ -147,10 +147,14 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     out.kv = matrix ? &mKv : nullptr;
     out.A = matrix ? &mA : nullptr;
     out.aero = matrix ? &mAero : nullptr;
+    out.aeroPsd = matrix && in.aeroPosition ? &mAeroPsd : nullptr;
     out.skewed = false;
     if (matrix) mAero.clear();
     addForces(in, out);
-    if (matrix) mSkewed = out.skewed;
+    if (matrix) {
+        mSkewed = out.skewed;
+        mAeroPosition = in.aeroPosition && !mAero.empty();
+    }
 }
 
 void Body::contactConstraints(const Environment& env, double t, double h) {
@@ -238,7 +242,20 @@ void Body::skewProduct(const VecX& x, VecX& y) const {
     y.setZero(x.size());
     for (const AeroCoupling& c : mAero) {
         if (c.v[0] < 0) continue;
-        const Vec3 w = c.axis.cross(cornerSum(c, x));
+        Vec3 w = c.axis.cross(cornerSum(c, x));
+        if (mAeroPosition && c.v[2] >= 0) {
+            // The orientation part less its PSD part (which is in A).
+            const Vec3 d0 = x.segment<3>(3 * c.v[0]);
+            w += c.velocityRest * cornerSum(c, x);
+            w += c.position * ((x.segment<3>(3 * c.v[1]) - d0).cross(c.e2) +
+                               c.e1.cross(x.segment<3>(3 * c.v[2]) - d0));
+            const Mat9& psd = mAeroPsd[static_cast<size_t>(&c - mAero.data())];
+            Eigen::Matrix<double, 9, 1> xt;
+            for (int k = 0; k < 3; ++k) xt.segment<3>(3 * k) = x.segment<3>(3 * c.v[k]);
+            const Eigen::Matrix<double, 9, 1> px = psd * xt;
+            for (int k = 0; k < 3; ++k) y.segment<3>(3 * c.v[k]) += w - px.segment<3>(3 * k);
+            continue;
+        }
         for (int k = 0; k < 3; ++k)
             if (c.v[k] >= 0) y.segment<3>(3 * c.v[k]) += w;
     }
@@ -266,7 +283,7 @@ double Body::aeroQuadratic(const VecX& x) const {
 SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
     SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver, mOptions.cgTolerance,
                                    mOptions.cgMaxIterations);
-    if (!mSkewed || !ls.converged || ls.failed) return ls;
+    if (!(mSkewed || mAeroPosition) || !ls.converged || ls.failed) return ls;
     const long n3 = b.size();
     const auto dot = [&](const VecX& u, const VecX& w) {
         return deterministicDot(u.data(), w.data(), static_cast<size_t>(n3));
@@ -357,7 +374,16 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
             converged = std::sqrt(dot(rhs - r, rhs - r)) <= target;
         }
     }
-    if (converged && y.allFinite()) {
+    // Newton's iterations (mAeroPosition) take GMRES's iterate whenever it beats the start: the
+    // symmetric solve is no Newton direction there. The linearised step keeps the fallback.
+    bool better = converged;
+    if (!converged && mAeroPosition && !failed && y.allFinite()) {
+        op(y, r);
+        const double after = std::sqrt(dot(rhs - r, rhs - r));
+        op(dv - z, r);
+        better = after < 0.5 * std::sqrt(dot(rhs - r, rhs - r));
+    }
+    if (better && y.allFinite()) {
         dv = y + z;
     } else {
         ++ls.skewFallbacks; // dv keeps the symmetric solve
@@ -374,7 +400,7 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
     in.v = mV.data();
     assemble(in, out, gravity, withMatrix);
     mG.resize(3 * n);
-    double rInf = 0.0;
+    double rInf = 0.0, r2 = 0.0;
     for (size_t i = 0; i < n; ++i) {
         Vec3 g = mMass[i] * dv.segment<3>(3 * i) - h * mF.segment<3>(3 * i);
         const uint8_t kind = mConstraints.kind[i];
@@ -388,7 +414,9 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
         const double e = (mDiagInv[i] * g).norm(); // m/s
         if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();
         rInf = std::max(rInf, e);
+        r2 += e * e;
     }
+    mResidual2 = std::sqrt(r2);
     return rInf;
 }
 
@@ -488,7 +516,9 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
     std::fill(mConstraints.z.begin(), mConstraints.z.end(), 0.0);
     for (int k = 0;; ++k) {
         // f_k and A_k at the iterate; g_k; G_k = f_k − f_E(x_k) (f_E from the accepted trial).
+        in.aeroPosition = mOptions.newtonFullJacobian && k < mOptions.newtonIterations;
         rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, k < mOptions.newtonIterations);
+        in.aeroPosition = false;
         if (rInf <= mOptions.newtonTolerance || k == mOptions.newtonIterations ||
             !std::isfinite(rInf))
             break;
@@ -502,6 +532,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         if (ns.failed || !delta.allFinite()) break;
         dvBase = mDv;
         const double phiBase = phi(dvBase, energy, dvBase);
+        const double base2 = mResidual2;
         slope = mG.dot(delta);
         alpha = 1.0;
         bool accepted = false;
@@ -510,8 +541,15 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
             trialX = x0 + h * (v0 + mDv);
             const double eTrial = elasticAt(trialX, t1, fElTrial);
             phiTrial = phi(mDv, eTrial, dvBase);
-            if (std::isfinite(phiTrial) && phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0) &&
-                stretchFeasible(trialX)) {
+            bool ok = std::isfinite(phiTrial) &&
+                      phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0);
+            // With the full Jacobian δ is Newton's direction for the residual itself, which Φ_k
+            // (forces frozen) need not see decrease: a step that lowers the residual is progress.
+            if (mAeroPosition && std::isfinite(phiTrial) && !ok) {
+                residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+                ok = mResidual2 <= (1.0 - kArmijo * alpha) * base2;
+            }
+            if (ok && stretchFeasible(trialX)) {
                 energy = eTrial;
                 mFel = fElTrial;
                 accepted = true;

@@ -47,6 +47,10 @@ struct StepOptions {
     // `newtonTolerance` (m/s).
     int newtonIterations = 0;
     double newtonTolerance = 0.01;
+    // Newton's iterations solve with the full Jacobian: also how the aerodynamic force turns
+    // with each triangle (∂F/∂x) and the parts of ∂F/∂v the symmetric damping drops, by GMRES.
+    // Off: the SPD linearisation of every iterate (cheaper; no quadratic convergence).
+    bool newtonFullJacobian = true;
     bool warmStart = true;      // start CG from the previous substep's Δv
     // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
     // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
@@ -99,6 +103,14 @@ struct AeroCoupling {
     std::array<int, 3> v{-1, -1, -1};
     Mat3 damping = Mat3::Zero();
     Vec3 axis = Vec3::Zero();
+    // Newton's full Jacobian only (ForceInput::aeroPosition): the force's dependence on the
+    // triangle's orientation, −h²∂f/∂x δ at every corner = P((δ₁ − δ₀) × e₂ + e₁ × (δ₂ − δ₀)),
+    // P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner).
+    Mat3 position = Mat3::Zero();
+    Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero();
+    // ... and what `damping` and `axis` leave out of the exact (h/9)∂F/∂v (the clamped negative
+    // part, a gated skew part): Newton's iterations solve with the exact Jacobian.
+    Mat3 velocityRest = Mat3::Zero();
 };
 
 // What a body's force routine reads and writes.
@@ -109,6 +121,7 @@ struct ForceInput {
     double t = 0.0, h = 0.0;
     double airDensity = 1.225;
     AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    bool aeroPosition = false; // also the orientation part of ∂F/∂x (AeroCoupling::position)
 };
 struct ForceOutput {
     VecX* f = nullptr;          // forces (N), accumulated
@@ -118,6 +131,10 @@ struct ForceOutput {
     int clamped = 0;
     // The aerodynamic linearisation per element when asked for (one slot each; empty: none).
     std::vector<AeroCoupling>* aero = nullptr;
+    // With ForceInput::aeroPosition: per triangle, the PSD part of the symmetrised orientation
+    // Jacobian (9×9, corners' blocks), also added to A so that the preconditioner sees it; the
+    // rest of AeroCoupling::position stays in the Krylov operator.
+    std::vector<Mat9>* aeroPsd = nullptr;
     bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
 };
 
@@ -228,6 +245,10 @@ private:
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
+    bool mAeroPosition = false;      // ... with the orientation part (Newton's iterations)
+    std::vector<Mat9> mAeroPsd;
+    double mResidual2 = 0.0; // residualAt()'s 2-norm of the velocity residual (m/s)      // ... its
+                             // PSD part, in A (ForceOutput::aeroPsd)
     double mStretchBefore = 0.0; // the largest edge stretch at the substep's start
     double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
     Constraints mZeroZ;              // mConstraints with z = 0 (solveLinear's preconditioner)

@@ -6,6 +6,8 @@
 // matrix of the triangle contributes D/9 to each of its 9 corner blocks.
 #include "solver/cloth.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -69,6 +71,27 @@ void addTriangleBlocks(BlockMatrix& A, const int slot[9], const MembraneFactors*
             if (b != a) A.addBlock(slot[3 * b + a], kba);
         }
     }
+}
+// The PSD part of the symmetrised orientation Jacobian of one triangle (AeroCoupling::position):
+// blocks K_ab = P C_b for every corner a, with C₁ = −[e₂]×, C₂ = [e₁]×, C₀ = −C₁ − C₂; the
+// symmetric ½(K + Kᵀ) with its negative eigenvalues dropped (Teran et al. 2005's projection).
+Mat3 crossMatrix(const Vec3& e) { // [e]× x = e × x
+    Mat3 m;
+    m << 0, -e.z(), e.y(), e.z(), 0, -e.x(), -e.y(), e.x(), 0;
+    return m;
+}
+
+Mat9 orientationPsd(const AeroCoupling& c) {
+    const Mat3 c1 = -crossMatrix(c.e2), c2 = crossMatrix(c.e1), c0 = -c1 - c2;
+    const Mat3 pc[3] = {c.position * c0, c.position * c1, c.position * c2};
+    Mat9 k;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) k.block<3, 3>(3 * a, 3 * b) = pc[b];
+    const Mat9 sym = 0.5 * (k + k.transpose());
+    Eigen::SelfAdjointEigenSolver<Mat9> eig(sym);
+    if (eig.info() != Eigen::Success) return Mat9::Zero();
+    const Eigen::Matrix<double, 9, 1> l = eig.eigenvalues().cwiseAbs();
+    return eig.eigenvectors() * l.asDiagonal() * eig.eigenvectors().transpose();
 }
 } // namespace
 
@@ -168,6 +191,7 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
     if (out.aero) out.aero->assign(aeroMatrix ? nt : 0, AeroCoupling{}); // one slot per triangle
+    if (out.aeroPsd) out.aeroPsd->assign(aeroMatrix && out.aero ? nt : 0, Mat9::Zero());
     std::atomic<bool> skewedAll{false}; // any triangle with a skew part
     // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
     // they share no vertex, so each vertex and slot receives its terms in the same order on any
@@ -205,8 +229,29 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                 if (aeroMatrix) {
                     hD9 = (h / 9.0) * r.damping;
                     withD = true;
-                    if (out.aero)
-                        (*out.aero)[e] = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
+                    if (out.aero) {
+                        AeroCoupling& c = (*out.aero)[e];
+                        c = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
+                        if (in.aeroPosition) {
+                            c.position = (-h * h / 6.0) * aeroTriangleAreaJacobian(
+                                                              wind - u, areaNormal, in.airDensity,
+                                                              cl, cd, mMat.aeroModel);
+                            c.e1 = p[1] - p[0];
+                            c.e2 = p[2] - p[0];
+                            c.velocityRest = (h / 9.0) * aeroTriangleExactJacobian(
+                                                             wind - u, areaNormal, in.airDensity,
+                                                             cl, cd, mMat.aeroModel) -
+                                             hD9 - crossMatrix(c.axis);
+                            if (out.aeroPsd && A) {
+                                (*out.aeroPsd)[e] = orientationPsd(c);
+                                const Mat9& s9 = (*out.aeroPsd)[e];
+                                for (int a = 0; a < 3; ++a)
+                                    for (int b = 0; b < 3; ++b)
+                                        A->addBlock(mTriSlots[e][3 * a + b],
+                                                    s9.block<3, 3>(3 * a, 3 * b));
+                            }
+                        }
+                    }
                     if (r.skewAxis.squaredNorm() > 0.0) skewedAll.store(true, std::memory_order_relaxed);
                 }
             }

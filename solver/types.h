@@ -13,6 +13,7 @@ namespace gale::solver {
 
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
+using Mat9 = Eigen::Matrix<double, 9, 9>;
 using VecX = Eigen::VectorXd;
 
 // Units everywhere: metres, seconds, kilograms (forces in N, stiffness in N/m, ...).

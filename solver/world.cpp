@@ -84,10 +84,15 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
             std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
                           troubleName(st.trouble), st.reason.c_str(), kRetryNewtonIterations);
             body.restore(snap);
+            // The retry wants the line search's cut of an over-stretching step, not convergence:
+            // the SPD linearisation of each iterate (no GMRES on the full Jacobian).
+            const bool full = body.options().newtonFullJacobian;
             body.options().newtonIterations = kRetryNewtonIterations;
+            body.options().newtonFullJacobian = false;
             const int firstIterations = st.iterations;
             st = body.substep(env, t, h);
             body.options().newtonIterations = newton;
+            body.options().newtonFullJacobian = full;
             st.iterations += firstIterations;
             ++stats.newtonRetries;
             stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None ? ": accepted" : ": still in trouble"));
