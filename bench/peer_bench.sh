@@ -17,9 +17,10 @@ if ! dpkg-query -W -f='${Status}' libbullet-dev 2>/dev/null | grep -q "install o
     fi
 fi
 if [ -f "$BUILD/CMakeCache.txt" ]; then
-    cmake -S . -B "$BUILD" >/dev/null
+    cmake -S . -B "$BUILD" >/dev/null 2>&1 || cmake -S . -B "$BUILD"
 else
-    cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null 2>&1 ||
+        cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release
 fi
 cmake --build "$BUILD" --target gale gale_bench_bullet_flag >/dev/null
 exec python3 bench/flag_bench.py --build "$BUILD" --only peer "$@"
