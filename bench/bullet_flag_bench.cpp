@@ -2,7 +2,10 @@
 // (1 m × 1 m, 0.005 kg/m², pinned along the pole edge x = 0, uniform wind 3° off edge-on) as a
 // Bullet soft body (Debian's libbullet-dev), stepped at a fixed step; prints one JSON line.
 //   gale_bench_bullet_flag [--wind U] [--angle DEG] [--steps-per-frame N] [--frames F]
-//                          [--fps R] [--res N] [--iterations P] [--obj DIR]
+//                          [--fps R] [--res N] [--iterations P] [--lift K] [--drag K] [--obj DIR]
+// Bullet's F_TwoSidedLiftDrag (btSoftBody.cpp, 3.24): drag ½ kDG ρ |v|² A cosθ along the flow
+// (gale's drag term), lift ½ kLF ρ |v| A sinθ across it, only beyond 10° from broadside — one
+// power of |v| below gale's ½ C_L ρ |v|² A, so --lift 0.3·U matches gale's lift at speed U.
 // "bounded": every position finite and every link under 3× its rest length at every frame end
 // (the over-stretch limit gale's own substep check uses).
 #include <BulletSoftBody/btSoftBodyHelpers.h>
@@ -29,6 +32,8 @@ struct Options {
     double fps = 24.0;
     int res = 24;       // vertices per side, as gale's grid res
     int iterations = 1; // Bullet's position-solver iterations (m_cfg.piterations)
+    double lift = 0.3;  // kLF (gale's lift = 0.3)
+    double drag = 1.0;  // kDG (gale's drag = 1.0)
     std::string objDir; // write DIR/flag.NNNN.obj per frame (frame 1 = rest) when set
 };
 
@@ -51,6 +56,10 @@ bool parse(int argc, char** argv, Options& o) {
             o.res = std::atoi(v);
         else if (a == "--iterations")
             o.iterations = std::atoi(v);
+        else if (a == "--lift")
+            o.lift = std::atof(v);
+        else if (a == "--drag")
+            o.drag = std::atof(v);
         else if (a == "--obj")
             o.objDir = v;
         else
@@ -102,7 +111,7 @@ int main(int argc, char** argv) {
     if (!parse(argc, argv, o)) {
         std::fprintf(stderr, "usage: gale_bench_bullet_flag [--wind U] [--angle DEG] "
                              "[--steps-per-frame N] [--frames F] [--fps R] [--res N] "
-                             "[--iterations P] [--obj DIR]\n");
+                             "[--iterations P] [--lift K] [--drag K] [--obj DIR]\n");
         return 2;
     }
     const double cpu0 = cpuSeconds();
@@ -135,8 +144,8 @@ int main(int argc, char** argv) {
     sb->m_cfg.kDP = 0.0;
     sb->m_cfg.collisions = 0; // nothing to collide with; no self-collision either (as gale)
     sb->m_cfg.aeromodel = btSoftBody::eAeroModel::F_TwoSidedLiftDrag;
-    sb->m_cfg.kLF = 0.3; // gale's lift = 0.3, drag = 1.0
-    sb->m_cfg.kDG = 1.0;
+    sb->m_cfg.kLF = o.lift;
+    sb->m_cfg.kDG = o.drag;
     sb->setTotalMass(0.005, true); // 0.005 kg/m² × 1 m², lumped by face area as gale's
     int pinned = 0;
     for (int i = 0; i < sb->m_nodes.size(); ++i)
@@ -171,17 +180,17 @@ int main(int argc, char** argv) {
     const double processWall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     world.removeSoftBody(sb.get());
-    std::printf("{\"wind\": %g, \"angle\": %g, \"steps_per_frame\": %d, \"step\": %.9g, "
-                "\"frames\": %d, \"frames_run\": %d, \"vertices\": %d, \"pinned\": %d, "
-                "\"links\": %d, \"faces\": %d, \"bounded\": %s, \"first_unbounded_frame\": %d, "
-                "\"max_stretch\": %.6g, \"tip_mean_y\": %.6g, \"ms_per_frame\": %.6g, "
-                "\"cpu_ms_per_frame\": %.6g, \"setup_cpu_seconds\": %.6g, "
-                "\"process_seconds\": %.6g, \"single_precision\": %s}\n",
-                o.wind, o.angle, o.stepsPerFrame, h, o.frames, framesRun, sb->m_nodes.size(),
-                pinned, sb->m_links.size(), sb->m_faces.size(),
-                firstUnbounded == 0 ? "true" : "false", firstUnbounded,
-                std::isfinite(worst) ? worst : -1.0, firstUnbounded == 0 ? tipMean : 0.0,
-                1000 * loopWall / framesRun, 1000 * loopCpu / framesRun, setupCpu, processWall,
-                sizeof(btScalar) == 4 ? "true" : "false");
+    std::printf(
+        "{\"wind\": %g, \"angle\": %g, \"steps_per_frame\": %d, \"step\": %.9g, "
+        "\"frames\": %d, \"frames_run\": %d, \"vertices\": %d, \"pinned\": %d, "
+        "\"links\": %d, \"faces\": %d, \"bounded\": %s, \"first_unbounded_frame\": %d, "
+        "\"max_stretch\": %.6g, \"tip_mean_y\": %.6g, \"ms_per_frame\": %.6g, "
+        "\"cpu_ms_per_frame\": %.6g, \"setup_cpu_seconds\": %.6g, "
+        "\"process_seconds\": %.6g, \"lift\": %g, \"drag\": %g, \"single_precision\": %s}\n",
+        o.wind, o.angle, o.stepsPerFrame, h, o.frames, framesRun, sb->m_nodes.size(), pinned,
+        sb->m_links.size(), sb->m_faces.size(), firstUnbounded == 0 ? "true" : "false",
+        firstUnbounded, std::isfinite(worst) ? worst : -1.0, firstUnbounded == 0 ? tipMean : 0.0,
+        1000 * loopWall / framesRun, 1000 * loopCpu / framesRun, setupCpu, processWall, o.lift,
+        o.drag, sizeof(btScalar) == 4 ? "true" : "false");
     return 0;
 }

@@ -87,10 +87,10 @@ def median_runs(n, fn):
 # ---------------------------------------------------------------------------------------------
 # peer: gale at one substep per frame against Bullet's soft body (bench/bullet_flag_bench.cpp)
 
-def run_bullet(args, speed, steps, iterations):
+def run_bullet(args, speed, steps, iterations, lift):
     exe = os.path.join(args.build, "bench", "gale_bench_bullet_flag")
     cmd = [exe, "--wind", str(speed), "--steps-per-frame", str(steps), "--iterations",
-           str(iterations), "--frames", str(FRAMES_AFTER_REST)]
+           str(iterations), "--lift", str(lift), "--frames", str(FRAMES_AFTER_REST)]
     cpu0, wall0 = child_cpu(), time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, check=True)
     wall, cpu = time.perf_counter() - wall0, child_cpu() - cpu0
@@ -107,7 +107,9 @@ def peer(args, tmp):
         return
     speeds = [20] if args.quick else [20, 40]
     steps_list = [16, 32, 64, 128]  # per 1/24 s frame: 1/384, 1/768, 1/1536, 1/3072 s
-    its_list = [1, 2, 4]             # Bullet's position iterations (1 = its default)
+    # Bullet's position iterations (1 = its default) and lift coefficient: gale's 0.3, and 0.3·U,
+    # which gives Bullet's lift (one power of |v| lower) gale's magnitude at U.
+    variants = [(1, 1.0), (2, 1.0), (4, 1.0), (2, None), (4, None)]
     print("\n### gale against Bullet's soft body (%d frames, one thread, median of %d)\n"
           % (FRAMES_AFTER_REST, args.repeats))
     print("| wind | solver | step (s) | bounded | max stretch | step ms/frame (wall) | "
@@ -130,10 +132,12 @@ def peer(args, tmp):
             s["newton_retries"], s["rejected_substeps"], s["status"])
         rows = [(label, "1/24", "yes", s["max_stretch"]) + g]
         best = None
-        for its in its_list:
+        for its, lift in variants:
+            lift = 0.3 if lift else 0.3 * speed
             for steps in steps_list:
-                d, t = median_runs(args.repeats, lambda: run_bullet(args, speed, steps, its))
-                rows.append(("Bullet, %d position iteration%s" % (its, "s" if its > 1 else ""),
+                d, t = median_runs(args.repeats, lambda: run_bullet(args, speed, steps, its, lift))
+                rows.append(("Bullet, %d position iteration%s, lift %g" % (
+                    its, "s" if its > 1 else "", lift),
                              "1/%d" % (24 * steps), "yes" if d["bounded"] else
                              "no (frame %d)" % d["first_unbounded_frame"],
                              d["max_stretch"] if d["max_stretch"] >= 0 else math.inf,
