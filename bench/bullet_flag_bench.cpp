@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
     world.addSoftBody(sb.get());
 
     const double h = 1.0 / (o.fps * o.stepsPerFrame);
-    if (!o.objDir.empty()) writeObj(*sb, o.objDir, 1);
+    bool written = o.objDir.empty() || writeObj(*sb, o.objDir, 1);
     const double setupCpu = cpuSeconds() - cpu0;
     double worst = maxLinkStretch(*sb);
     int firstUnbounded = 0;
@@ -170,7 +170,7 @@ int main(int argc, char** argv) {
         const double stretch = maxLinkStretch(*sb);
         worst = std::max(worst, stretch);
         tipMean += sb->m_nodes[tip].m_x.y() / o.frames;
-        if (!o.objDir.empty()) writeObj(*sb, o.objDir, f + 2);
+        written = written && (o.objDir.empty() || writeObj(*sb, o.objDir, f + 2));
         if (!(stretch < 3.0) && firstUnbounded == 0) firstUnbounded = f + 2;
         if (!std::isfinite(stretch)) break; // nothing left to measure
     }
@@ -180,6 +180,11 @@ int main(int argc, char** argv) {
     const double processWall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     world.removeSoftBody(sb.get());
+    if (!written) {
+        std::fprintf(stderr, "gale_bench_bullet_flag: cannot write the frames to %s\n",
+                     o.objDir.c_str());
+        return 3;
+    }
     std::printf(
         "{\"wind\": %g, \"angle\": %g, \"steps_per_frame\": %d, \"step\": %.9g, "
         "\"frames\": %d, \"frames_run\": %d, \"vertices\": %d, \"pinned\": %d, "

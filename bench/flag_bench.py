@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # Issue 14's flag benchmarks, all through `gale sim` (whatever the binary does; every count is
 # read back from run.json): gale against Bullet's soft body on the gossamer flag ("peer"), error
-# against a fine-step reference versus wall time ("error"), and Newton/CG iterations per step
+# against a fine-step reference versus time ("error"), and Newton/CG iterations per step
 # for 32², 64², 128² flags ("iterations"). Each section prints a Markdown table; ratios are
 # against a baseline measured in the same run, and every timing is the median of --repeats.
 #   bench/flag_bench.py [--build build] [--only peer|error|iterations] [--repeats 3] [--quick]
@@ -44,7 +44,11 @@ def run_gale(args, sets, out, frames=None):
     cpu0, wall0 = child_cpu(), time.perf_counter()
     p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     wall, cpu = time.perf_counter() - wall0, child_cpu() - cpu0
-    with open(os.path.join(out, "run.json")) as f:
+    path = os.path.join(out, "run.json")
+    if not os.path.exists(path):
+        sys.exit("flag_bench.py: `%s` exited %d without run.json:\n%s"
+                 % (" ".join(cmd), p.returncode, p.stderr.strip()[-2000:]))
+    with open(path) as f:
         run = json.load(f)
     run["_exit"] = p.returncode
     return run, wall, cpu
@@ -196,6 +200,9 @@ def error(args, tmp):
     ref_run, _, _ = run_gale(args, ref_sets, ref, frames)
     ref_wall = time.perf_counter() - t0
     rs = summarise(ref_run)
+    if rs["status"] != "ok":
+        sys.exit("flag_bench.py: the reference run ended '%s' (exit %d); try --ref-substeps"
+                 % (rs["status"], rs["exit"]))
     n = len(read_obj(os.path.join(ref, "flag.0001.obj")))
     tip = n - 1  # the free corner (x = 1, y = 2 at rest)
     ref_shapes = frame_shapes(ref, checkpoints)
@@ -236,6 +243,11 @@ def error(args, tmp):
         s = summarise(run)
         if base is None:
             base = cpu
+        if not all(os.path.exists(os.path.join(out, "flag.%04d.obj" % f))
+                   for f in range(1, last + 1)):
+            print("| %s | %s (exit %d): frames missing, no errors | | | | | | | %s| | | | | | | |"
+                  % (label, s["status"], s["exit"], "| " * len(checkpoints)))
+            continue
         errs = []
         for c in checkpoints:
             rms, mx = distances(read_obj(os.path.join(out, "flag.%04d.obj" % c)), ref_shapes[c])
