@@ -360,7 +360,9 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     for (Level& L : mLevels) {
         if (&L != &mLevels[0]) { // level 0's copy was made above
             L.lowVal.resize(L.a.val.size());
-            for (size_t k = 0; k < L.a.val.size(); ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+            parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+                for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+            });
         }
         L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
         std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
