@@ -140,6 +140,7 @@ struct SimOptions {
     int threads = 1;               // 0: all hardware threads; results do not depend on it
     bool json = false;             // print run.json's content to stdout at the end
     std::vector<std::string> allowPaths; // --allow-path DIR (files named by expressions)
+    std::string cache;             // --cache mdd: OUTDIR/<object>.mdd point caches too
 };
 int runSim(const SimOptions& options);
 Command addSimCommand(CLI::App& app);
