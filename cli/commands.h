@@ -156,6 +156,10 @@ struct WedgeOptions {
     bool emitOnly = false;
     int threads = 1;               // each simulation's --threads
     std::vector<std::string> allowPaths; // --allow-path DIR, passed on to every variant's sim
+    std::string farm;              // --farm slurm: also OUTDIR/submit.sbatch, run nothing locally
+    bool submit = false;           // --submit: sbatch it, print the job id
+    std::string partition;         // --partition P of the Slurm array
+    std::string status;            // --status OUTDIR: report progress instead
 };
 int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);
