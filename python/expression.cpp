@@ -11,9 +11,13 @@
 
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -43,6 +47,24 @@ py::list diagnosticList(const lang::SourceFile& source, const lang::DiagnosticSi
         out.append(item);
     }
     return out;
+}
+
+// How many of the n doubles at p are infinite or NaN (exponent bits all set), reading only
+// each value's high word: a loop the compiler vectorises with baseline SSE2.
+uint32_t nonFiniteCount(const double* p, size_t n) {
+    uint32_t count = 0;
+    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(p);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    constexpr size_t kHigh = 4;
+#else
+    constexpr size_t kHigh = 0;
+#endif
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t high;
+        std::memcpy(&high, bytes + 8 * i + kHigh, 4);
+        count += (high & 0x7ff00000u) == 0x7ff00000u;
+    }
+    return count;
 }
 
 py::object valueObject(const std::vector<double>& v) {
@@ -152,13 +174,6 @@ py::array Expression::eval(const py::object& pointsObj, std::optional<double> t,
         converted = py::array_t<double, py::array::c_style | py::array::forcecast>(points);
         data = converted.data();
     }
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k)
-            if (!std::isfinite(data[static_cast<std::ptrdiff_t>(i) * pointStride + k * compStride]))
-                raise(ErrorKind::Argument, "P[" + std::to_string(i) +
-                                               "] is not finite (NaN or infinite); "
-                                               "every point must be a finite position");
-
     // Uniforms: $t and $frame each default from the other through fps, as `gale eval` does.
     const double tv = t ? *t : frame ? *frame / fps : 0.0;
     const double fv = frame ? *frame : tv * fps;
@@ -209,29 +224,69 @@ py::array Expression::eval(const py::object& pointsObj, std::optional<double> t,
     }
     for (size_t i = 0; i < mParams.size(); ++i)
         request.uniforms.push_back({mParams[i].name, values[i], ""});
-    runtime::VaryingInput p;
-    p.name = "P";
-    p.width = 3;
-    p.data = data;
-    p.pointStride = pointStride;
-    p.compStride = compStride;
-    request.varyings.push_back(p);
-
     const int w = mProgram->resultWidth();
     std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(n)};
     if (w != 1) shape.push_back(w);
+    bool usesId = false;
+    for (const lang::HostInput& in : mProgram->bytecode().inputs)
+        usesId = usesId || in.name == "id";
+
+    // In chunks that stay in cache: each chunk is evaluated, then its points are checked
+    // (finite) from cache, so the check costs no second pass over memory; a non-finite point
+    // raises and the result is dropped. Chunks run one VM thread each, on `threads` threads
+    // (tbb), in any order: the VM's lanes do not depend on how points are split. $id is the
+    // point's index in the whole array, as one call would number it.
+    const size_t workers = threads == 0
+                               ? static_cast<size_t>(tbb::this_task_arena::max_concurrency())
+                               : static_cast<size_t>(threads);
+    const size_t kChunk =
+        workers <= 1 ? size_t(1) << 16
+                     : std::clamp<size_t>(n / (8 * workers), size_t(1) << 12, size_t(1) << 16);
+    const size_t chunks = (n + kChunk - 1) / kChunk;
+    std::vector<std::string> chunkMessages(chunks);
+    std::vector<size_t> chunkBad(chunks, n);
+    std::vector<std::string> chunkError(chunks);
     runtime::EvalResult r;
     py::array out;
     auto run = [&](auto* typed) {
         using T = std::remove_pointer_t<decltype(typed)>;
         py::array_t<T> result(shape);
-        runtime::EvalOutput<T> o;
-        o.data = result.mutable_data();
-        o.pointStride = w;
-        o.compStride = 1;
-        if (n > 0) {
+        T* dst = result.mutable_data();
+        auto doChunk = [&](size_t c) {
+            const size_t at = c * kChunk, m = std::min(kChunk, n - at);
+            const double* p = data + static_cast<std::ptrdiff_t>(at) * pointStride;
+            std::vector<double> ids(usesId ? m : 0);
+            for (size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<double>(at + i);
+            runtime::EvalRequest chunk = request;
+            chunk.count = m;
+            chunk.threads = 1;
+            chunk.varyings.push_back({"P", 3, p, pointStride, compStride});
+            if (usesId) chunk.varyings.push_back({"id", 1, ids.data(), 1, 1});
+            runtime::EvalOutput<T> o;
+            o.data = dst + at * static_cast<size_t>(w);
+            o.pointStride = w;
+            o.compStride = 1;
+            runtime::EvalResult cr = runtime::evaluate<T>(*mProgram, chunk, o);
+            chunkMessages[c] = std::move(cr.messages);
+            if (!cr.ok) chunkError[c] = cr.error.empty() ? "evaluation failed" : cr.error;
+            // Checked after the chunk's evaluation, while its points are still in cache (a
+            // check first would add a pass over memory the evaluation cannot overlap).
+            const bool contiguous = pointStride == 3 && compStride == 1;
+            if (contiguous && nonFiniteCount(p, 3 * m) == 0) return;
+            for (size_t i = 0; i < m && chunkBad[c] == n; ++i)
+                for (int k = 0; k < 3; ++k)
+                    if (!std::isfinite(
+                            p[static_cast<std::ptrdiff_t>(i) * pointStride + k * compStride]))
+                        chunkBad[c] = at + i;
+        };
+        {
             py::gil_scoped_release release;
-            r = runtime::evaluate<T>(*mProgram, request, o);
+            if (workers <= 1 || chunks == 1) {
+                for (size_t c = 0; c < chunks; ++c) doChunk(c);
+            } else {
+                tbb::task_arena arena(static_cast<int>(workers));
+                arena.execute([&] { tbb::parallel_for(size_t(0), chunks, doChunk); });
+            }
         }
         out = result;
     };
@@ -239,6 +294,20 @@ py::array Expression::eval(const py::object& pointsObj, std::optional<double> t,
         run(static_cast<float*>(nullptr));
     else
         run(static_cast<double*>(nullptr));
+    std::string messages;
+    for (size_t c = 0; c < chunks; ++c) messages += chunkMessages[c];
+    for (size_t c = 0; c < chunks; ++c)
+        if (chunkBad[c] != n)
+            raise(ErrorKind::Argument, "P[" + std::to_string(chunkBad[c]) +
+                                           "] is not finite (NaN or infinite); "
+                                           "every point must be a finite position");
+    for (size_t c = 0; c < chunks; ++c)
+        if (!chunkError[c].empty()) {
+            r.ok = false;
+            r.error = chunkError[c];
+            break;
+        }
+    r.messages = messages;
     if (!r.messages.empty()) py::module_::import("sys").attr("stderr").attr("write")(r.messages);
     if (!r.ok) raise(ErrorKind::Argument, "cannot evaluate " + mSource.name() + ": " + r.error);
     return out;

@@ -79,3 +79,19 @@ def test_input_is_not_copied_and_empty_arrays_work():
     P = np.arange(12, dtype=np.float64).reshape(4, 3)
     np.testing.assert_array_equal(e.eval(P, precision="double"), P * 2)
     assert e.eval(np.zeros((0, 3))).shape == (0, 3)
+
+
+@pytest.mark.parametrize("threads", [1, 0, 3])
+def test_large_arrays_number_points_across_the_whole_array(threads):
+    # eval works through large arrays in pieces: $id must still be the index in the whole
+    # array, every point must be evaluated, and a NaN far in must still be found.
+    n = 300_001
+    P = np.zeros((n, 3))
+    P[:, 0] = np.arange(n) * 0.5
+    e = gale.compile(source="[$id, $P[0] * 2, 1]")
+    got = e.eval(P, precision="double", threads=threads)
+    np.testing.assert_array_equal(got[:, 0], np.arange(n))
+    np.testing.assert_array_equal(got[:, 1], np.arange(n, dtype=np.float64))
+    P[n - 2, 2] = np.nan
+    with pytest.raises(gale.ArgumentError, match=f"P\\[{n - 2}\\] is not finite"):
+        e.eval(P, threads=threads)
