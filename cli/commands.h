@@ -160,6 +160,7 @@ struct WedgeOptions {
     bool submit = false;           // --submit: sbatch it, print the job id
     std::string partition;         // --partition P of the Slurm array
     std::string status;            // --status OUTDIR: report progress instead
+    std::string cache;             // --cache mdd, passed on to every variant's sim
 };
 int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);

@@ -61,9 +61,9 @@ std::string shellQuote(const std::string& text);
 
 // The idempotent task line of a variant folder: skips when DONE exists, else runs (or resumes)
 // `gale sim scene.toml -o .` there, appending to log.txt, and touches DONE on success. Each of
-// `allowPaths` (absolute) is passed on as --allow-path.
+// `allowPaths` (absolute) is passed on as --allow-path, `cache` (when set) as --cache.
 std::string taskCommand(const std::string& galeBinary, const std::string& variantDir, int threads,
-                        const std::vector<std::string>& allowPaths = {});
+                        const std::vector<std::string>& allowPaths = {}, const std::string& cache = "");
 
 // True when `dir` has DONE and every object's frame file of the variant.
 bool variantComplete(const Variant& v, const std::string& dir);

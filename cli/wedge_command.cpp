@@ -69,6 +69,11 @@ int runWedge(const WedgeOptions& o) {
                    "tasks.txt; docs/wedge.md)");
         return kExitUsage;
     }
+    if (!o.cache.empty() && o.cache != "mdd") {
+        printError("--cache must be mdd (each variant's OUTDIR/<variant>/<object>.mdd), not '" +
+                   o.cache + "'");
+        return kExitUsage;
+    }
     if ((o.submit || !o.partition.empty()) && o.farm.empty()) {
         printError("--submit and --partition go with --farm slurm");
         return kExitUsage;
@@ -184,7 +189,7 @@ int runWedge(const WedgeOptions& o) {
             ++restarted;
         }
         if (int rc = writeTextFileAtomic((dir / "scene.toml").string(), text)) return rc;
-        commands.push_back(taskCommand(gale, dir.string(), o.threads, allowPaths));
+        commands.push_back(taskCommand(gale, dir.string(), o.threads, allowPaths, o.cache));
         tasks += commands.back() + '\n';
     }
     if (int rc = writeTextFileAtomic((out / "tasks.txt").string(), tasks)) return rc;
@@ -324,6 +329,9 @@ Command addWedgeCommand(CLI::App& app) {
                     "failed or not "
                     "started, from manifest.jsonl and the frames on disk (give it alone)")
         ->type_name("OUTDIR");
+    sub->add_option("--cache", o->cache,
+                    "Each variant's simulation also writes point caches: mdd (gale sim --cache)")
+        ->type_name("FORMAT");
     sub->add_option("--threads", o->threads, "Threads of each simulation (default 1; 0: all)")
         ->type_name("N");
     addAllowPathOption(*sub, o->allowPaths);

@@ -142,7 +142,7 @@ TOML
 
 # ---- a 4-variant wedge, submitted ----
 run "$GALE" wedge tiny.toml --vary cloth.c.lift=0.1,0.3 --vary cloth.c.drag=0.8,1.2 -o w --farm slurm --submit \
-    --partition gale
+    --partition gale --cache mdd
 expect_rc 0 "wedge --farm slurm --submit ($ERR)"
 job=$OUT
 expect_match "$job" '^[0-9]+$' "prints the job id"
@@ -153,6 +153,8 @@ wait_job "$job"
 for d in w/v00*/; do
     [ -f "$d/DONE" ] || fail "$d finished on the cluster ($(cat "$d/log.txt" 2> /dev/null | tail -n 2))"
     for f in $(seq -f %04g 1 24); do [ -s "$d/c.$f.obj" ] || { fail "$d/c.$f.obj"; break; }; done
+    # --cache mdd reaches the tasks: a 24-frame cache of the 144 vertices (big-endian header).
+    expect_eq "$(od -An -tx1 -N8 "$d/c.mdd" 2> /dev/null | tr -d ' \n')" "0000001800000090" "$d/c.mdd header"
 done
 expect_eq "$(ls w/logs | wc -l)" "4" "one log per task in w/logs"
 expect_match "$(cat w/logs/${job}_1.out)" "gale wedge: task 1 on" "the task log names the task"
