@@ -37,8 +37,8 @@ def main():
     rng = np.random.default_rng(1)
     P = rng.uniform(-50, 50, size=(n, 3))
     print(f"{n} points, float, best of >= 0.5 s")
-    print("| expression | threads | gale bench ns/pt | Python eval ns/pt | Python / bench |")
-    print("|---|---|---|---|---|")
+    print("| expression | threads | gale bench ns/pt | Python eval ns/pt | Python / bench | with out= | out= / bench |")
+    print("|---|---|---|---|---|---|---|")
     for expr in EXPRS:
         e = gale.compile(source=expr)
         for threads in (1, 0):
@@ -46,8 +46,11 @@ def main():
                                              str(threads), "--json"], capture_output=True, text=True,
                                             check=True).stdout)["ns_per_point"]
             py = best_ns(lambda: e.eval(P, threads=threads), n)
+            out = np.empty((n,) if e.width == 1 else (n, e.width), np.float32)
+            inplace = best_ns(lambda: e.eval(P, threads=threads, out=out), n)
             short = expr if len(expr) < 40 else expr[:37] + "..."
-            print(f"| `{short}` | {threads or 'all'} | {cli:.2f} | {py:.2f} | {py / cli:.3f}× |")
+            print(f"| `{short}` | {threads or 'all'} | {cli:.2f} | {py:.2f} | {py / cli:.3f}× | {inplace:.2f} | "
+                  f"{inplace / cli:.3f}× |")
 
     # 8 Python threads on one program (1 VM thread each) against the same 8 calls in one thread.
     e = gale.compile(source=EXPRS[2])

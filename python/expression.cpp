@@ -136,7 +136,8 @@ int Expression::width() const {
 
 py::array Expression::eval(const py::object& pointsObj, std::optional<double> t,
                            std::optional<double> frame, const py::object& paramsObj,
-                           const std::string& precision, int threads, double fps) const {
+                           const std::string& precision, int threads, double fps,
+                           const py::object& outObj) const {
     if (precision != "float" && precision != "double")
         raise(ErrorKind::Argument,
               "precision must be \"float\" or \"double\", not \"" + precision + "\"");
@@ -250,8 +251,26 @@ py::array Expression::eval(const py::object& pointsObj, std::optional<double> t,
     py::array out;
     auto run = [&](auto* typed) {
         using T = std::remove_pointer_t<decltype(typed)>;
-        py::array_t<T> result(shape);
-        T* dst = result.mutable_data();
+        py::array result;
+        if (outObj.is_none()) {
+            result = py::array_t<T>(shape);
+        } else {
+            // out=: the caller's array, written in place (no allocation per call).
+            if (!py::isinstance<py::array>(outObj))
+                raise(ErrorKind::Argument, "out must be a numpy array");
+            result = py::reinterpret_borrow<py::array>(outObj);
+            bool ok = result.dtype().is(py::dtype::of<T>()) &&
+                      result.ndim() == static_cast<py::ssize_t>(shape.size()) &&
+                      (result.flags() & py::array::c_style) && result.writeable();
+            for (size_t k = 0; ok && k < shape.size(); ++k)
+                ok = result.shape(static_cast<py::ssize_t>(k)) == shape[k];
+            if (!ok)
+                raise(ErrorKind::Argument, std::string("out must be a writeable C-contiguous ") +
+                                               (sizeof(T) == 4 ? "float32" : "float64") +
+                                               " array of shape (" + std::to_string(n) +
+                                               (w == 1 ? "" : ", " + std::to_string(w)) + ")");
+        }
+        T* dst = static_cast<T*>(result.mutable_data());
         auto doChunk = [&](size_t c) {
             const size_t at = c * kChunk, m = std::min(kChunk, n - at);
             const double* p = data + static_cast<std::ptrdiff_t>(at) * pointStride;
@@ -321,6 +340,7 @@ void addExpression(py::module_& m) {
         .def("eval", &Expression::eval, py::arg("P"), py::kw_only(), py::arg("t") = py::none(),
              py::arg("frame") = py::none(), py::arg("params") = py::none(),
              py::arg("precision") = "float", py::arg("threads") = 0, py::arg("fps") = 24.0,
+             py::arg("out") = py::none(),
              "Evaluates at the points P ((N, 3) float32 or float64; float64 is read in place). $t "
              "and $frame "
              "default from each other through fps; params overrides declared parameters by name. "

@@ -24,8 +24,8 @@ public:
     Expression(const std::optional<std::string>& path, const std::optional<std::string>& source,
                const std::vector<std::string>& allowPaths);
     py::array eval(const py::object& points, std::optional<double> t, std::optional<double> frame,
-                   const py::object& params, const std::string& precision, int threads,
-                   double fps) const;
+                   const py::object& params, const std::string& precision, int threads, double fps,
+                   const py::object& out) const;
     py::dict params() const;
     int width() const;
     const lang::SourceFile& source() const { return mSource; }

@@ -95,3 +95,15 @@ def test_large_arrays_number_points_across_the_whole_array(threads):
     P[n - 2, 2] = np.nan
     with pytest.raises(gale.ArgumentError, match=f"P\\[{n - 2}\\] is not finite"):
         e.eval(P, threads=threads)
+
+
+def test_out_writes_in_place_and_is_checked():
+    e = gale.compile(source="$P * 3")
+    P = np.random.default_rng(5).uniform(-1, 1, (1000, 3))
+    out = np.full((1000, 3), np.nan, dtype=np.float32)
+    got = e.eval(P, out=out)
+    assert got is out or np.shares_memory(got, out)
+    np.testing.assert_array_equal(out, e.eval(P))
+    for bad in [np.empty((1000, 3)), np.empty((999, 3), np.float32), np.empty((3, 1000), np.float32).T, [0.0]]:
+        with pytest.raises(gale.ArgumentError, match="out must be"):
+            e.eval(P, out=bad)
