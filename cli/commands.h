@@ -140,6 +140,7 @@ struct SimOptions {
     int threads = 1;               // 0: all hardware threads; results do not depend on it
     bool json = false;             // print run.json's content to stdout at the end
     std::vector<std::string> allowPaths; // --allow-path DIR (files named by expressions)
+    std::string cache;             // --cache mdd: OUTDIR/<object>.mdd point caches too
 };
 int runSim(const SimOptions& options);
 Command addSimCommand(CLI::App& app);
@@ -155,6 +156,11 @@ struct WedgeOptions {
     bool emitOnly = false;
     int threads = 1;               // each simulation's --threads
     std::vector<std::string> allowPaths; // --allow-path DIR, passed on to every variant's sim
+    std::string farm;              // --farm slurm: also OUTDIR/submit.sbatch, run nothing locally
+    bool submit = false;           // --submit: sbatch it, print the job id
+    std::string partition;         // --partition P of the Slurm array
+    std::string status;            // --status OUTDIR: report progress instead
+    std::string cache;             // --cache mdd, passed on to every variant's sim
 };
 int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);

@@ -40,7 +40,8 @@ std::vector<std::string> splitDots(const std::string& key) {
     size_t start = 0;
     for (;;) {
         const size_t dot = key.find('.', start);
-        parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+        parts.push_back(
+            key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
         if (dot == std::string::npos) return parts;
         start = dot + 1;
     }
@@ -81,7 +82,8 @@ bool parseVary(const std::string& text, VaryAxis& out, std::string& error) {
     if (eq != std::string::npos) out.key = trim(text.substr(0, eq));
     const std::vector<std::string> parts = splitDots(out.key);
     bool ok = eq != std::string::npos && !out.key.empty();
-    for (const std::string& p : parts) ok = ok && !p.empty() && p.find_first_of(" \t") == std::string::npos;
+    for (const std::string& p : parts)
+        ok = ok && !p.empty() && p.find_first_of(" \t") == std::string::npos;
     if (ok) {
         const std::string rest = text.substr(eq + 1);
         int depth = 0;
@@ -108,15 +110,18 @@ bool parseVary(const std::string& text, VaryAxis& out, std::string& error) {
         ok = ok && depth == 0 && quote == 0;
     }
     if (!ok)
-        error = "--vary '" + text + "': expected KEY=V1,V2,... with a dotted scene path and values as --set takes "
-                "them (cloth.cape.lift=0.1,0.3,0.5; vectors in brackets: windicator.direction=[1,0,0],[1,0,1])";
+        error = "--vary '" + text +
+                "': expected KEY=V1,V2,... with a dotted scene path and values as --set takes "
+                "them (cloth.cape.lift=0.1,0.3,0.5; vectors in brackets: "
+                "windicator.direction=[1,0,0],[1,0,1])";
     return ok;
 }
 
 std::string sanitiseName(const std::string& text) {
     std::string out;
     for (unsigned char c : text) {
-        const bool keep = std::isalnum(c) || c == '.' || c == '_' || c == '=' || c == '+' || c == '-';
+        const bool keep =
+            std::isalnum(c) || c == '.' || c == '_' || c == '=' || c == '+' || c == '-';
         out += keep ? static_cast<char>(c) : '_';
     }
     return out;
@@ -192,9 +197,10 @@ std::string shellQuote(const std::string& text) {
 }
 
 std::string taskCommand(const std::string& galeBinary, const std::string& variantDir, int threads,
-                        const std::vector<std::string>& allowPaths) {
+                        const std::vector<std::string>& allowPaths, const std::string& cache) {
     std::string sim = shellQuote(galeBinary) + " sim scene.toml -o . --resume";
     if (threads != 1) sim += " --threads " + std::to_string(threads);
+    if (!cache.empty()) sim += " --cache " + shellQuote(cache);
     for (const std::string& dir : allowPaths) sim += " --allow-path " + shellQuote(dir);
     return "cd " + shellQuote(variantDir) + " && if [ ! -f DONE ]; then " + sim +
            " >> log.txt 2>&1 && touch DONE; fi";
@@ -215,10 +221,12 @@ bool variantComplete(const Variant& v, const std::string& dir) {
 std::string manifestLine(const Variant& v, const std::string& dir, const std::string& command,
                          const std::string& status, int exitCode) {
     std::string s = "{\"id\": " + jsonString(v.id) + ", \"index\": " + std::to_string(v.index) +
-                    ", \"folder\": " + jsonString(v.folder) + ", \"path\": " + jsonString(dir) + ", \"values\": {";
+                    ", \"folder\": " + jsonString(v.folder) + ", \"path\": " + jsonString(dir) +
+                    ", \"values\": {";
     for (size_t i = 0; i < v.values.size(); ++i)
         s += (i ? ", " : "") + jsonString(v.values[i].first) + ": " + jsonValue(v.values[i].second);
-    s += "}, \"frames\": [" + std::to_string(v.frameStart) + ", " + std::to_string(v.frameEnd) + "], \"objects\": [";
+    s += "}, \"frames\": [" + std::to_string(v.frameStart) + ", " + std::to_string(v.frameEnd) +
+         "], \"objects\": [";
     for (size_t i = 0; i < v.objects.size(); ++i)
         s += (i ? ", " : "") + std::string("{\"name\": ") + jsonString(v.objects[i].name) +
              ", \"format\": " + jsonString(v.objects[i].format) + "}";
@@ -235,7 +243,8 @@ void runPool(const std::vector<std::string>& commands, int jobs,
     struct sigaction action {};
     action.sa_handler = forwardSignal;
     sigemptyset(&action.sa_mask);
-    struct sigaction oldInt {}, oldTerm {}, oldHup {};
+    struct sigaction oldInt {
+    }, oldTerm{}, oldHup{};
     sigaction(SIGINT, &action, &oldInt);
     sigaction(SIGTERM, &action, &oldTerm);
     sigaction(SIGHUP, &action, &oldHup);
@@ -257,8 +266,8 @@ void runPool(const std::vector<std::string>& commands, int jobs,
             sigaddset(&defaults, SIGHUP);
             posix_spawnattr_setsigdefault(&attr, &defaults);
             const std::string& line = commands[next];
-            char* argv[] = {const_cast<char*>("sh"), const_cast<char*>("-c"), const_cast<char*>(line.c_str()),
-                            nullptr};
+            char* argv[] = {const_cast<char*>("sh"), const_cast<char*>("-c"),
+                            const_cast<char*>(line.c_str()), nullptr};
             pid_t pid = 0;
             const int rc = posix_spawn(&pid, "/bin/sh", nullptr, &attr, argv, environ);
             posix_spawnattr_destroy(&attr);

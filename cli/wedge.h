@@ -61,9 +61,9 @@ std::string shellQuote(const std::string& text);
 
 // The idempotent task line of a variant folder: skips when DONE exists, else runs (or resumes)
 // `gale sim scene.toml -o .` there, appending to log.txt, and touches DONE on success. Each of
-// `allowPaths` (absolute) is passed on as --allow-path.
+// `allowPaths` (absolute) is passed on as --allow-path, `cache` (when set) as --cache.
 std::string taskCommand(const std::string& galeBinary, const std::string& variantDir, int threads,
-                        const std::vector<std::string>& allowPaths = {});
+                        const std::vector<std::string>& allowPaths = {}, const std::string& cache = "");
 
 // True when `dir` has DONE and every object's frame file of the variant.
 bool variantComplete(const Variant& v, const std::string& dir);
@@ -79,5 +79,17 @@ std::string manifestLine(const Variant& v, const std::string& dir, const std::st
 // are passed on to the running commands before the pool re-raises them.
 void runPool(const std::vector<std::string>& commands, int jobs,
              const std::function<void(size_t, int)>& done);
+
+// The Slurm array script of a wedge in `outDir` (absolute) with `tasks` lines in tasks.txt:
+// one array task per line, logs in outDir/logs/%A_%a.out, --requeue, --cpus-per-task `threads`
+// (when > 0), --partition when given (cli/wedge_farm.cpp).
+std::string slurmScript(const std::string& outDir, size_t tasks, int threads, const std::string& partition,
+                        const std::string& scene);
+// Runs `sbatch --parsable script`; the job id in `jobId`. Prints the problem and returns an
+// exit code on failure.
+int submitSlurm(const std::string& script, std::string& jobId);
+// `gale wedge --status OUTDIR`: prints each variant of the manifest as done, partial (frames so
+// far), failed or not started, from the frames on disk; returns an exit code.
+int runWedgeStatus(const std::string& outDir);
 
 } // namespace gale::cli

@@ -1,0 +1,172 @@
+// A run's settings and per-frame statistics as JSON (run/sim_json.h), written by hand so the
+// text is the same byte for byte wherever it is produced (gale sim's run.json, Python's stats).
+#include "run/sim_json.h"
+
+#include "fields/scene.h"
+#include "io/pointset.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace gale::run {
+
+using io::jsonString;
+using solver::Body;
+
+namespace {
+
+std::string num(double v) {
+    return std::isfinite(v) ? io::formatNumber(v) : "null";
+}
+
+std::string vec(const std::vector<double>& v) {
+    std::string s = "[";
+    for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + num(v[i]);
+    return s + "]";
+}
+
+// A parameter as JSON: its value at `t`, and whether it is keyframed.
+std::string paramJson(const fields::Param& p, double t) {
+    std::string s = p.width() == 1 ? num(p.scalarAt(t)) : vec(p.at(t));
+    return p.isKeyed() ? "{\"at_start\": " + s + ", \"keyed\": true}" : s;
+}
+
+const char* solverName(solver::LinearSolverKind k) {
+    return k == solver::LinearSolverKind::Direct ? "direct" : "pcg";
+}
+
+std::string stepJson(const solver::StepOptions& s) {
+    return "\"linear_solver\": \"" + std::string(solverName(s.linearSolver)) +
+           "\", \"cg_tolerance\": " + num(s.cgTolerance) +
+           ", \"cg_max_iterations\": " + std::to_string(s.cgMaxIterations) +
+           ", \"preconditioner\": \"" +
+           (s.preconditioner == solver::Preconditioner::Multigrid ? "multigrid" : "jacobi") +
+           "\", \"newton_iterations\": " + std::to_string(s.newtonIterations) +
+           ", \"newton_tolerance\": " + num(s.newtonTolerance);
+}
+
+} // namespace
+
+std::string settingsJson(const solver::SimScene& sc,
+                         const std::vector<std::unique_ptr<Body>>& bodies, int first, int last,
+                         int threads) {
+    const fields::SceneSettings& s = sc.wind.settings;
+    const double t0 = first / s.fps;
+    std::ostringstream o;
+    o << "{\"scene\": " << jsonString(sc.wind.path) << ", \"fps\": " << num(s.fps)
+      << ", \"frames\": [" << first << ", " << last << "], \"substeps\": " << s.substeps
+      << ", \"gravity\": " << vec(s.gravity) << ", \"air_density\": " << num(s.airDensity)
+      << ", \"threads\": " << threads
+      << ", \"solver\": {\"max_halvings\": " << sc.solver.maxHalvings
+      << ", \"over_stretch\": " << num(sc.solver.overStretch)
+      << ", \"velocity_jump\": " << num(sc.solver.velocityJump) << "}";
+    o << ", \"fields\": [";
+    for (size_t i = 0; i < sc.wind.fields.size(); ++i)
+        o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
+    o << "], \"objects\": [";
+    size_t bi = 0;
+    for (const solver::ClothSpec& c : sc.cloths) {
+        const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
+        const solver::ClothMaterial& m = c.material;
+        o << (bi > 1 ? ", " : "") << "{\"name\": " << jsonString(c.name)
+          << ", \"kind\": \"cloth\", \"geometry\": "
+          << (c.meshPath.empty() ? "\"grid\"" : jsonString(c.meshPath))
+          << ", \"vertices\": " << (b ? b->vertexCount() : 0)
+          << ", \"pinned\": " << (b ? b->pinnedVertices().size() : 0)
+          << ", \"density\": " << num(m.density) << ", \"stretch\": " << paramJson(m.stretch, t0)
+          << ", \"shear\": " << paramJson(m.shear, t0) << ", \"bend\": " << paramJson(m.bend, t0)
+          << ", \"damping\": " << paramJson(m.damping, t0)
+          << ", \"lift\": " << paramJson(c.lift.value, t0) << ", \"lift_painted\": "
+          << (c.lift.map.empty() && c.lift.exprPath.empty() && c.lift.source.empty() ? "false"
+                                                                                     : "true")
+          << ", \"drag\": " << paramJson(c.drag.value, t0) << ", \"drag_painted\": "
+          << (c.drag.map.empty() && c.drag.exprPath.empty() && c.drag.source.empty() ? "false"
+                                                                                     : "true")
+          << ", \"aero_model\": \""
+          << (m.aeroModel == solver::AeroModel::Frozen ? "frozen" : "smooth-lift")
+          << "\", \"aero_jacobian\": \""
+          << (c.step.aeroJacobian == solver::AeroJacobian::Paper ? "paper" : "projected") << "\", "
+          << stepJson(c.step) << ", \"output\": \"" << c.output << "\"}";
+    }
+    for (const solver::HairSpec& h : sc.hairs) {
+        const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
+        const solver::HairMaterial& m = h.material;
+        o << (bi > 1 ? ", " : "") << "{\"name\": " << jsonString(h.name)
+          << ", \"kind\": \"hair\", \"geometry\": "
+          << (h.strandsPath.empty() ? "\"grid\"" : jsonString(h.strandsPath))
+          << ", \"vertices\": " << (b ? b->vertexCount() : 0) << ", \"radius\": " << num(m.radius)
+          << ", \"density\": " << num(m.density) << ", \"stretch\": " << paramJson(m.stretch, t0)
+          << ", \"bend\": " << paramJson(m.bend, t0)
+          << ", \"damping\": " << paramJson(m.damping, t0)
+          << ", \"drag_normal\": " << paramJson(h.dragNormal.value, t0)
+          << ", \"drag_tangent\": " << paramJson(h.dragTangent.value, t0)
+          << ", \"root_pinned\": " << (m.rootPinned ? "true" : "false") << ", " << stepJson(h.step)
+          << ", \"output\": \"" << h.output << "\"}";
+    }
+    o << "], \"colliders\": [";
+    for (size_t i = 0; i < sc.colliders.size(); ++i) {
+        const solver::Collider& c = sc.colliders[i];
+        const char* type = c.shape == solver::ColliderShape::Plane    ? "plane"
+                           : c.shape == solver::ColliderShape::Sphere ? "sphere"
+                           : c.shape == solver::ColliderShape::Mesh   ? "mesh"
+                                                                      : "capsule";
+        o << (i ? ", " : "") << "{\"name\": " << jsonString(c.name) << ", \"type\": \"" << type
+          << "\", \"radius\": " << num(c.radius) << ", \"thickness\": " << num(c.thickness)
+          << ", \"friction\": " << num(c.friction) << "}";
+    }
+    o << "]}";
+    return o.str();
+}
+
+std::string frameJson(const solver::FrameStats& f) {
+    std::ostringstream o;
+    o << "{\"frame\": " << f.frame << ", \"time\": " << num(f.time)
+      << ", \"wall_seconds\": " << num(f.wallSeconds)
+      << ", \"failed\": " << (f.failed ? "true" : "false") << ", \"objects\": [";
+    for (size_t i = 0; i < f.bodies.size(); ++i) {
+        const solver::BodyFrameStats& b = f.bodies[i];
+        o << (i ? ", " : "") << "{\"name\": " << jsonString(b.name)
+          << ", \"substeps\": " << b.substeps << ", \"rejected_substeps\": " << b.rejected
+          << ", \"recovered_substeps\": " << b.recovered
+          << ", \"newton_retries\": " << b.newtonRetries
+          << ", \"deepest_halving\": " << b.deepestHalving
+          << ", \"solver_iterations\": " << b.iterations
+          << ", \"max_iterations\": " << b.maxIterations
+          << ", \"max_residual\": " << num(b.maxResidual)
+          << ", \"newton_iterations\": " << b.newtonIterations
+          << ", \"max_newton_iterations\": " << b.maxNewtonIterations
+          << ", \"max_newton_residual\": " << num(b.maxNewtonResidual)
+          << ", \"line_search_cuts\": " << b.lineSearchCuts
+          << ", \"newton_unconverged\": " << b.newtonStalled
+          << ", \"max_speed\": " << num(b.maxSpeed) << ", \"max_stretch\": " << num(b.maxStretch)
+          << ", \"energy\": {\"kinetic\": " << num(b.kinetic) << ", \"elastic\": " << num(b.elastic)
+          << ", \"potential\": " << num(b.potential)
+          << ", \"total\": " << num(b.kinetic + b.elastic + b.potential)
+          << "}, \"wind_non_finite\": " << b.windNonFinite
+          << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
+          << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";
+        for (size_t e = 0; e < b.events.size(); ++e)
+            o << (e ? ", " : "") << jsonString(b.events[e]);
+        o << "]}";
+    }
+    o << "]}";
+    return o.str();
+}
+
+solver::FrameStats initialStats(const solver::World& w, int frame, double fps) {
+    solver::FrameStats f;
+    f.frame = frame;
+    f.time = frame / fps;
+    for (const auto& b : w.bodies()) {
+        solver::BodyFrameStats s;
+        s.name = b->name();
+        s.maxStretch = b->maxEdgeStretch();
+        s.kinetic = b->kineticEnergy();
+        s.potential = b->potentialEnergy(w.settings().gravity);
+        s.elastic = const_cast<Body&>(*b).elasticEnergy(f.time);
+        f.bodies.push_back(s);
+    }
+    return f;
+}
+
+} // namespace gale::run
