@@ -246,7 +246,7 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
                         "{ box = [x0, y0, z0, x1, y1, z1] }, not " + tomlTypeName(n));
         return false;
     }
-    checkKeys(*t, {"vertices", "map", "box", "translate"}, what);
+    checkKeys(*t, {"vertices", "map", "box", "translate", "rotate"}, what);
     bool ok = true;
     if (const toml::node* v = t->get("vertices")) {
         const toml::array* a = v->as_array();
@@ -283,6 +283,38 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
             out.translate = *p;
         else
             ok = false;
+    }
+    // rotate = { pivot = [x, y, z], axis = [x, y, z], angle = degrees | { keys = [[t, deg], ...] } }
+    if (const toml::node* r = t->get("rotate")) {
+        const toml::table* rt = r->as_table();
+        if (!rt) {
+            error(*r, what + ": rotate must be a table { pivot = [x, y, z], axis = [x, y, z], angle = degrees or keys }, not " +
+                          tomlTypeName(*r));
+            return false;
+        }
+        checkKeys(*rt, {"pivot", "axis", "angle"}, what + " rotate");
+        out.rotate.active = true;
+        if (const toml::node* n = rt->get("pivot")) ok = vec3(*n, what + ": rotate pivot", out.rotate.pivot) && ok;
+        if (const toml::node* n = rt->get("axis")) {
+            if (vec3(*n, what + ": rotate axis", out.rotate.axis)) {
+                if (!(out.rotate.axis.norm() > 0.0)) {
+                    error(*n, what + ": rotate axis must not be zero");
+                    ok = false;
+                }
+            } else {
+                ok = false;
+            }
+        }
+        if (const toml::node* n = rt->get("angle")) {
+            std::optional<fields::Param> p = param(*n, what + ": rotate angle (degrees)", 1, -1e300);
+            if (p)
+                out.rotate.angle = *p;
+            else
+                ok = false;
+        } else {
+            error(*r, what + ": rotate needs angle = degrees or { keys = [[t0, deg0], [t1, deg1]] }");
+            ok = false;
+        }
     }
     return ok;
 }

@@ -80,10 +80,39 @@ void Body::addPins(const PinSet& pins) {
     }
 }
 
+namespace {
+Vec3 translationAt(const fields::Param& p, double t) {
+    double d[3] = {0.0, 0.0, 0.0};
+    if (p.width() >= 3) p.evaluate(t, d);
+    return Vec3(d[0], d[1], d[2]);
+}
+// The rotation of a PinRotation at t (identity when inactive or about a zero axis).
+Mat3 rotationAt(const PinRotation& r, double t) {
+    if (!r.active || !(r.axis.norm() > 0.0)) return Mat3::Identity();
+    const double rad = r.angle.scalarAt(t) * (M_PI / 180.0);
+    return Eigen::AngleAxisd(rad, r.axis.normalized()).toRotationMatrix();
+}
+} // namespace
+
 Vec3 Body::pinTarget(size_t k, double t) const {
-    const std::vector<double> d = mPinSets[mPinSet[k]].translate.at(t);
-    Vec3 off = d.size() >= 3 ? Vec3(d[0], d[1], d[2]) : Vec3::Zero();
-    return mAnchor.segment<3>(3 * k) + off;
+    const PinSet& set = mPinSets[mPinSet[k]];
+    const Vec3 anchor = mAnchor.segment<3>(3 * k);
+    const Vec3 rotated = set.rotate.active ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
+                                           : anchor;
+    return rotated + translationAt(set.translate, t);
+}
+
+Vec3 Body::pinVelocity(size_t k, double t) const {
+    const PinSet& set = mPinSets[mPinSet[k]];
+    constexpr double d = 1e-6; // s: the right derivative (the motion ahead), exact on linear keys
+    Vec3 v = (translationAt(set.translate, t + d) - translationAt(set.translate, t)) / d;
+    if (set.rotate.active && set.rotate.axis.norm() > 0.0) {
+        const double omega = (set.rotate.angle.scalarAt(t + d) - set.rotate.angle.scalarAt(t)) / d *
+                             (M_PI / 180.0); // rad/s
+        const Vec3 r = rotationAt(set.rotate, t) * (mAnchor.segment<3>(3 * k) - set.rotate.pivot);
+        v += (omega * set.rotate.axis.normalized()).cross(r);
+    }
+    return v;
 }
 
 void Body::restore(const Snapshot& s) {

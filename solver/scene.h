@@ -26,13 +26,14 @@ struct PaintedSpec {
 };
 
 // Pinned vertices: a list, a painted map (> 0.5 pins), a box, or any union of them, moved by
-// an optional keyframed translation.
+// an optional keyframed rotation about a pivot and a keyframed translation (body.h, PinSet).
 struct PinSpec {
     std::vector<int> vertices;
     std::string map;
     bool hasBox = false;
     double box[6] = {0, 0, 0, 0, 0, 0};
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}};
+    PinRotation rotate;
     int line = 0, col = 0;
 };
 

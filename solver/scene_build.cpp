@@ -208,6 +208,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         if (spec.hasPins) {
             PinSet pins;
             pins.translate = spec.pins.translate;
+            pins.rotate = spec.pins.rotate;
             const size_t n = mesh.vertexCount();
             for (int idx : spec.pins.vertices) {
                 if (idx < 0 || static_cast<size_t>(idx) >= n) {
