@@ -39,10 +39,10 @@ std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
 }
 const std::vector<std::string> kClothKeys =
     withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
-                  "drag", "aero_model", "aero_jacobian"});
+                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh"});
 const std::vector<std::string> kHairKeys =
     withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
-                  "drag_normal", "drag_tangent", "root_pinned"});
+                  "drag_normal", "drag_tangent", "root_pinned", "rest_shape"});
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
@@ -421,6 +421,16 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
             c.step.aeroJacobian = v == "paper" ? AeroJacobian::Paper : AeroJacobian::Projected;
     }
     if (const toml::node* n = t.get("pins")) c.hasPins = pins(*n, what + " pins", c.pins);
+    if (const toml::node* n = t.get("rest_shape")) choice(*n, "rest_shape", {"mesh", "flat"}, c.restShape);
+    if (const toml::node* n = t.get("rest_mesh")) {
+        std::string file;
+        c.restLine = static_cast<int>(n->source().begin.line);
+        c.restCol = static_cast<int>(n->source().begin.column);
+        if (!mesh)
+            error(*n, what + ": rest_mesh needs mesh = \"file\" (the rest shape of a loaded mesh; a grid is flat)");
+        else if (string(*n, what + ": rest_mesh", file))
+            c.restMeshPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    }
     stepOptions(t, what, c.step, c.output);
 }
 
@@ -496,6 +506,13 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
     if (const toml::node* n = t.get("drag_normal")) painted(*n, what + ": drag_normal", baseDir, h.dragNormal);
     if (const toml::node* n = t.get("drag_tangent")) painted(*n, what + ": drag_tangent", baseDir, h.dragTangent);
     if (const toml::node* n = t.get("root_pinned")) boolean(*n, what + ": root_pinned", h.material.rootPinned);
+    // Bending rest shape: the strand's own polyline (a curl; the default for loaded strands) or
+    // straight (the default for generated ones, which are straight anyway).
+    h.material.curledRest = strands != nullptr;
+    if (const toml::node* n = t.get("rest_shape")) {
+        std::string v;
+        if (choice(*n, "rest_shape", {"strand", "straight"}, v)) h.material.curledRest = v == "strand";
+    }
     if (const toml::node* n = t.get("pins"))
         error(*n, what + ": strands are pinned at their roots (root_pinned = true); pins maps are for cloth");
     stepOptions(t, what, h.step, h.output);

@@ -332,3 +332,52 @@ pins = { vertices = [0], rotate = { axis = [0, 0, 0] } }
     CHECK(bad.all().find("rotate needs angle") != std::string::npos);
     CHECK(bad.all().find(":4:") != std::string::npos);
 }
+
+TEST_CASE("scene: rest_shape and rest_mesh", "[scene][rest]") {
+    TempDir dir;
+    // A sheet folded 90° along its middle edge: start pose flat, rest pose folded.
+    dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n");
+    dir.write("fold.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 1\nf 1 2 3\nf 2 4 3\n");
+    dir.write("fewer.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    Loaded l = load(dir, R"(
+[[cloth]]
+name = "a"
+mesh = "flat.obj"
+rest_mesh = "fold.obj"
+
+[[cloth]]
+name = "b"
+mesh = "fold.obj"
+rest_shape = "flat"
+)");
+    INFO(l.all());
+    REQUIRE(l.ok);
+    std::vector<std::unique_ptr<Body>> bodies;
+    std::vector<gale::fields::SceneError> errors;
+    std::vector<std::string> warnings;
+    REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
+    // a: starts flat (its positions), rest folded: bending energy > 0 at the start; the rest
+    // lengths are the fold's, so the diagonal 2-3 (√2 in both) is unstretched.
+    CHECK(bodies[0]->positions()[11] == 0.0);
+    CHECK(bodies[0]->elasticEnergy(0.0) > 0.0);
+    // b: a folded mesh with a flat rest costs the fold's energy; with the default ("mesh") none.
+    CHECK(bodies[1]->elasticEnergy(0.0) > 0.0);
+    Loaded d = load(dir, "[[cloth]]\nmesh = \"fold.obj\"\n");
+    REQUIRE(d.ok);
+    bodies.clear();
+    REQUIRE(buildBodies(d.scene, bodies, errors, warnings));
+    CHECK(bodies[0]->elasticEnergy(0.0) == Approx(0.0).margin(1e-15));
+
+    Loaded bad = load(dir, "[[cloth]]\nmesh = \"flat.obj\"\nrest_mesh = \"fewer.obj\"\n");
+    REQUIRE(bad.ok);
+    bodies.clear();
+    errors.clear();
+    CHECK_FALSE(buildBodies(bad.scene, bodies, errors, warnings));
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].render().find("fewer.obj") != std::string::npos);
+    CHECK(errors[0].render().find("3 vertices and 1 triangles against 4 and 2") != std::string::npos);
+    CHECK(errors[0].line == 3);
+    Loaded grid = load(dir, "[[cloth]]\ngrid = { size = [1, 1], res = [3, 3] }\nrest_mesh = \"fold.obj\"\n");
+    CHECK_FALSE(grid.ok);
+    CHECK(grid.all().find("rest_mesh needs mesh") != std::string::npos);
+}

@@ -44,6 +44,11 @@ struct ClothSpec {
     int gridRes[2] = {16, 16};
     Vec3 gridOrigin = Vec3::Zero();
     std::string gridAxes = "xy"; // the plane of the grid: u along the first axis, v the second
+    // Bending rest angles: "mesh" (the loaded mesh's, or rest_mesh's) | "flat"; "" — the
+    // default: "mesh" for a loaded mesh, "flat" for a grid.
+    std::string restShape;
+    std::string restMeshPath; // resolved; optional rest (sewing) shape, same topology as mesh
+    int restLine = 0, restCol = 0; // where rest_mesh was written
     ClothMaterial material;
     PaintedSpec lift, drag;
     bool hasPins = false;

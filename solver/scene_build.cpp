@@ -191,13 +191,43 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
                 v.push_back(hasUv ? mesh.uv[2 * i + 1] : 0.0);
             }
         }
+        // rest_mesh: rest lengths, areas and angles from it; the simulation starts from `mesh`.
+        TriMesh restMesh;
+        const bool hasRest = !spec.restMeshPath.empty();
+        if (hasRest) {
+            std::string error;
+            const std::string where = what + " rest_mesh '" + spec.restMeshPath + "'";
+            if (!loadMesh(spec.restMeshPath, restMesh, error)) {
+                fields::SceneError e = sceneError(scene, spec.restLine, spec.restCol, where + ": " + error);
+                e.io = true;
+                errors.push_back(std::move(e));
+                continue;
+            }
+            if (restMesh.vertexCount() != mesh.vertexCount() || restMesh.triangles != mesh.triangles) {
+                errors.push_back(sceneError(
+                    scene, spec.restLine, spec.restCol,
+                    where + " does not have the topology of '" + spec.meshPath + "' (" +
+                        std::to_string(restMesh.vertexCount()) + " vertices and " +
+                        std::to_string(restMesh.triangles.size()) + " triangles against " +
+                        std::to_string(mesh.vertexCount()) + " and " + std::to_string(mesh.triangles.size()) +
+                        ", or the faces differ): a rest mesh must be the same mesh in another pose"));
+                continue;
+            }
+            TriMesh r = mesh; // uv, attributes and faces of the simulated mesh, rest positions
+            r.positions = restMesh.positions;
+            restMesh = std::move(r);
+        }
+        const TriMesh& rest = hasRest ? restMesh : mesh;
         ClothMaterial mat = spec.material;
+        mat.curvedRest = spec.restShape.empty() ? !spec.meshPath.empty() : spec.restShape == "mesh";
         mat.lift.value = spec.lift.value;
         mat.drag.value = spec.drag.value;
-        bool ok = evaluateMap(scene, spec.lift, what + " lift", mesh.positions, u, v, mesh.attributes, mat.lift.map, errors, allowPaths);
-        ok = evaluateMap(scene, spec.drag, what + " drag", mesh.positions, u, v, mesh.attributes, mat.drag.map, errors, allowPaths) && ok;
+        bool ok = evaluateMap(scene, spec.lift, what + " lift", rest.positions, u, v, mesh.attributes, mat.lift.map, errors, allowPaths);
+        ok = evaluateMap(scene, spec.drag, what + " drag", rest.positions, u, v, mesh.attributes, mat.drag.map, errors, allowPaths) && ok;
         if (!ok) continue;
-        auto cloth = std::make_unique<Cloth>(spec.name, mesh, mat);
+        VecX start;
+        if (hasRest) start = Eigen::Map<const VecX>(mesh.positions.data(), static_cast<long>(mesh.positions.size()));
+        auto cloth = std::make_unique<Cloth>(spec.name, rest, mat, hasRest ? &start : nullptr);
         cloth->options() = spec.step;
         cloth->limits().overStretch = scene.solver.overStretch;
         cloth->limits().velocityJump = scene.solver.velocityJump;
