@@ -6,6 +6,7 @@
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "solver/mesh_collider.h"
+#include "solver/moving_collider.h"
 #include "solver/scene.h"
 
 #include "lang/functions.h"
@@ -70,7 +71,7 @@ private:
 
     void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
     void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
-    void loadCollider(const toml::table& t, size_t index, Collider& c);
+    void loadCollider(const toml::table& t, size_t index, double fps, Collider& c);
     void loadSolver(const toml::table& t, SolverSection& s);
 };
 
@@ -518,7 +519,7 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
     stepOptions(t, what, h.step, h.output);
 }
 
-void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
+void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collider& c) {
     c.name = "collider" + std::to_string(index);
     if (const toml::node* n = t.get("name")) string(*n, "[[collider]] name", c.name);
     const std::string what = "[[collider]] '" + c.name + "'";
@@ -572,6 +573,17 @@ void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
     const std::string path = p.is_absolute() ? file
                              : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
     std::string problem;
+    if (path.find('#') != std::string::npos) {
+        // A per-frame sequence: triangles, a refitted tree and continuous contact
+        // (solver/moving_collider.h) instead of an SDF rebuilt every frame.
+        std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, fps, problem);
+        if (!seq) {
+            error(*mesh, what + ": " + problem);
+            return;
+        }
+        c.moving = std::make_shared<MovingMeshContact>(std::move(seq));
+        return;
+    }
     c.mesh = MeshCollider::load(path, voxel, problem);
     if (!c.mesh) error(*mesh, what + ": " + problem);
 }
@@ -617,7 +629,7 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
     });
     list("collider", [&](const toml::table& t, size_t i) {
         Collider c;
-        loadCollider(t, i, c);
+        loadCollider(t, i, out.wind.settings.fps, c);
         out.colliders.push_back(std::move(c));
     });
     if (const toml::node* n = root.get("solver")) {

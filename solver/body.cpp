@@ -7,6 +7,7 @@
 // solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
 // same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
 #include "solver/body.h"
+#include "solver/moving_collider.h"
 
 #include <algorithm>
 #include <cmath>
@@ -188,6 +189,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     if (!env.colliders || env.colliders->empty()) return;
     const size_t n = vertexCount();
     for (const Collider& c : *env.colliders) {
+        if (c.moving) c.moving->prepare(t, t + h, c.thickness); // the step's tree (moving_collider.h)
         const ColliderPose pose = colliderPose(c, t);
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1) continue; // pinned or held
@@ -220,6 +222,7 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
             const ContactPoint cp = queryCollider(pose, x);
             const bool held = mContactCollider[i] == static_cast<int>(&c - env.colliders->data());
+            if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
             if (!(cp.distance < c.thickness) && !held) continue;
             touched[i] = 1;
             if (cp.distance < c.thickness) x += (c.thickness - cp.distance) * cp.normal;
@@ -712,7 +715,15 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     mV = v0 + mDv;
     mX = x0 + h * mV;
 
-    // 6. Colliders: push out, remove approach speed, Coulomb friction.
+    // 6. Colliders: moving meshes first swept continuously over the step (no vertex or edge
+    // crosses the surface, moving_collider.h), then push out, approach speed, Coulomb friction.
+    if (env.colliders)
+        for (const Collider& c : *env.colliders)
+            if (c.moving) {
+                std::vector<uint8_t> movable(n);
+                for (size_t i = 0; i < n; ++i) movable[i] = mConstraints.kind[i] != 1;
+                c.moving->sweep(x0, mX, mV, movable, mEdges, c.thickness, c.friction, h);
+            }
     st.contacts = resolveContacts(env, t + h, h);
 
     // 7. Trouble detection.
