@@ -40,10 +40,10 @@ std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
 }
 const std::vector<std::string> kClothKeys =
     withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
-                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh"});
+                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh", "attach"});
 const std::vector<std::string> kHairKeys =
     withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
-                  "drag_normal", "drag_tangent", "root_pinned", "rest_shape"});
+                  "drag_normal", "drag_tangent", "root_pinned", "rest_shape", "attach"});
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
@@ -66,7 +66,9 @@ private:
     bool numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out);
     std::optional<fields::Param> param(const toml::node& n, const std::string& what, int width, double min);
     bool painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out);
-    bool pins(const toml::node& n, const std::string& what, PinSpec& out);
+    bool pins(const toml::node& n, const std::string& what, PinSpec& out, bool attachKeys = false);
+    bool attach(const toml::node& n, const std::string& what, const std::string& baseDir, bool needSelection,
+                PinSpec& out, std::string& meshPath);
     void stepOptions(const toml::table& t, const std::string& what, StepOptions& s, std::string& output);
 
     void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
@@ -238,7 +240,7 @@ bool Loader::painted(const toml::node& n, const std::string& what, const std::st
     return ok;
 }
 
-bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
+bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out, bool attachKeys) {
     out.line = static_cast<int>(n.source().begin.line);
     out.col = static_cast<int>(n.source().begin.column);
     const toml::table* t = n.as_table();
@@ -247,7 +249,10 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
                         "{ box = [x0, y0, z0, x1, y1, z1] }, not " + tomlTypeName(n));
         return false;
     }
-    checkKeys(*t, {"vertices", "map", "box", "translate", "rotate"}, what);
+    if (attachKeys)
+        checkKeys(*t, {"mesh", "vertices", "map", "box"}, what);
+    else
+        checkKeys(*t, {"vertices", "map", "box", "translate", "rotate"}, what);
     bool ok = true;
     if (const toml::node* v = t->get("vertices")) {
         const toml::array* a = v->as_array();
@@ -317,6 +322,44 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
             ok = false;
         }
     }
+    return ok;
+}
+
+// attach = { mesh = "body.#.obj", vertices | map | box }: the selection keys of pins.
+bool Loader::attach(const toml::node& n, const std::string& what, const std::string& baseDir, bool needSelection,
+                    PinSpec& out, std::string& meshPath) {
+    out.line = static_cast<int>(n.source().begin.line);
+    out.col = static_cast<int>(n.source().begin.column);
+    const toml::table* t = n.as_table();
+    if (!t) {
+        error(n, what + " must be a table { mesh = \"body.#.obj\", box = [x0, y0, z0, x1, y1, z1] }, not " +
+                     tomlTypeName(n));
+        return false;
+    }
+    bool ok = true;
+    const toml::node* m = t->get("mesh");
+    std::string file;
+    if (!m) {
+        error(n, what + " needs mesh = \"file\" (the body to attach to: OBJ/PLY, or a '#' sequence)");
+        ok = false;
+    } else if (string(*m, what + ": mesh", file)) {
+        meshPath = std::filesystem::path(file).is_absolute()
+                       ? file
+                       : (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    } else {
+        ok = false;
+    }
+    if (!t->get("vertices") && !t->get("map") && !t->get("box")) {
+        if (needSelection) {
+            error(n, what + " needs vertices = [...], map = \"property\" or box = [x0, y0, z0, x1, y1, z1]");
+            ok = false;
+        }
+        return ok;
+    }
+    const int line = out.line, col = out.col;
+    ok = pins(n, what, out, true) && ok; // the selection keys, read as for pins
+    out.line = line;
+    out.col = col;
     return ok;
 }
 
@@ -422,6 +465,8 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
             c.step.aeroJacobian = v == "paper" ? AeroJacobian::Paper : AeroJacobian::Projected;
     }
     if (const toml::node* n = t.get("pins")) c.hasPins = pins(*n, what + " pins", c.pins);
+    if (const toml::node* n = t.get("attach"))
+        c.hasAttach = attach(*n, what + " attach", baseDir, true, c.attach, c.attachMesh);
     if (const toml::node* n = t.get("rest_shape")) choice(*n, "rest_shape", {"mesh", "flat"}, c.restShape);
     if (const toml::node* n = t.get("rest_mesh")) {
         std::string file;
@@ -514,6 +559,8 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
         std::string v;
         if (choice(*n, "rest_shape", {"strand", "straight"}, v)) h.material.curledRest = v == "strand";
     }
+    if (const toml::node* n = t.get("attach"))
+        h.hasAttach = attach(*n, what + " attach", baseDir, false, h.attach, h.attachMesh);
     if (const toml::node* n = t.get("pins"))
         error(*n, what + ": strands are pinned at their roots (root_pinned = true); pins maps are for cloth");
     stepOptions(t, what, h.step, h.output);

@@ -381,3 +381,65 @@ rest_shape = "flat"
     CHECK_FALSE(grid.ok);
     CHECK(grid.all().find("rest_mesh needs mesh") != std::string::npos);
 }
+
+TEST_CASE("scene: moving mesh colliders and attachments from a '#' sequence", "[scene][attach]") {
+    TempDir dir;
+    // A unit square plate in y = 0 moving up 0.1 m per frame, frames 1..3.
+    for (int f = 1; f <= 3; ++f) {
+        const std::string y = std::to_string(0.1 * (f - 1));
+        dir.write("plate.000" + std::to_string(f) + ".obj",
+                  "v -1 " + y + " -1\nv 1 " + y + " -1\nv 1 " + y + " 1\nv -1 " + y + " 1\nf 1 2 3\nf 1 3 4\n");
+    }
+    Loaded l = load(dir, R"(
+[scene]
+fps = 10
+frames = [1, 3]
+
+[[cloth]]
+name = "sheet"
+grid = { size = [0.5, 0.5], res = [3, 3], origin = [-0.25, 0.01, -0.25], axes = "xz" }
+attach = { mesh = "plate.#.obj", box = [-1, -1, -1, 0, 1, 1] }
+
+[[hair]]
+name = "tuft"
+grid = { size = [0.1, 0.1], count = [2, 2], length = 0.1, segments = 2, origin = [0, 0.002, 0], direction = [0, 1, 0] }
+attach = { mesh = "plate.#.obj" }
+
+[[collider]]
+name = "plate"
+type = "mesh"
+mesh = "plate.#.obj"
+)");
+    INFO(l.all());
+    REQUIRE(l.ok);
+    REQUIRE(l.scene.colliders.size() == 1);
+    CHECK(l.scene.colliders[0].moving);
+    CHECK(!l.scene.colliders[0].mesh);
+    std::vector<std::unique_ptr<Body>> bodies;
+    std::vector<gale::fields::SceneError> errors;
+    std::vector<std::string> warnings;
+    REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
+    // Cloth: the 6 vertices with x ≤ 0, 1 cm above the plate, following it up (frame 3 at t = 0.3).
+    REQUIRE(bodies[0]->pinnedVertices().size() == 6);
+    for (size_t k = 0; k < 6; ++k) {
+        const Vec3 p0 = bodies[0]->pinTarget(k, 0.1), p1 = bodies[0]->pinTarget(k, 0.3);
+        CHECK(p0.y() == Approx(0.01));
+        CHECK(p1.y() == Approx(0.21));
+        CHECK(bodies[0]->pinVelocity(k, 0.15).y() == Approx(1.0)); // 0.1 m per frame at 10 fps
+    }
+    // Hair: all four roots attached.
+    REQUIRE(bodies[1]->pinnedVertices().size() == 4);
+    CHECK(bodies[1]->pinTarget(0, 0.3).y() == Approx(0.202));
+
+    Loaded bad = load(dir, R"(
+[[cloth]]
+grid = { size = [0.5, 0.5], res = [3, 3] }
+attach = { mesh = "plate.#.obj", translate = [0, 1, 0] }
+)");
+    CHECK_FALSE(bad.ok);
+    CHECK(bad.all().find("translate") != std::string::npos);
+    CHECK(bad.all().find("needs vertices") != std::string::npos);
+    Loaded missing = load(dir, "[[collider]]\ntype = \"mesh\"\nmesh = \"nothing.#.obj\"\n");
+    CHECK_FALSE(missing.ok);
+    CHECK(missing.all().find("nothing.#.obj") != std::string::npos);
+}

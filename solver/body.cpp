@@ -7,6 +7,7 @@
 // solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
 // same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
 #include "solver/body.h"
+#include "solver/mesh_sequence.h"
 #include "solver/moving_collider.h"
 
 #include <algorithm>
@@ -75,6 +76,9 @@ void Body::addPins(const PinSet& pins) {
         if (std::find(mPinned.begin(), mPinned.end(), v) != mPinned.end()) continue;
         mPinned.push_back(v);
         mPinSet.push_back(set);
+        mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
+                                  ? std::make_shared<const SurfaceBinding>(bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                  : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
         mAnchor.tail<3>() = p;
@@ -97,6 +101,7 @@ Mat3 rotationAt(const PinRotation& r, double t) {
 
 Vec3 Body::pinTarget(size_t k, double t) const {
     const PinSet& set = mPinSets[mPinSet[k]];
+    if (mPinBinding[k]) return boundPosition(*set.attach, *mPinBinding[k], t);
     const Vec3 anchor = mAnchor.segment<3>(3 * k);
     const Vec3 rotated = set.rotate.active ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
                                            : anchor;
@@ -106,6 +111,7 @@ Vec3 Body::pinTarget(size_t k, double t) const {
 Vec3 Body::pinVelocity(size_t k, double t) const {
     const PinSet& set = mPinSets[mPinSet[k]];
     constexpr double d = 1e-6; // s: the right derivative (the motion ahead), exact on linear keys
+    if (mPinBinding[k]) return (pinTarget(k, t + d) - pinTarget(k, t)) / d;
     Vec3 v = (translationAt(set.translate, t + d) - translationAt(set.translate, t)) / d;
     if (set.rotate.active && set.rotate.axis.norm() > 0.0) {
         const double omega = (set.rotate.angle.scalarAt(t + d) - set.rotate.angle.scalarAt(t)) / d *

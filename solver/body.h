@@ -17,6 +17,9 @@
 
 namespace gale::solver {
 
+class MeshSequence; // solver/mesh_sequence.h
+struct SurfaceBinding;
+
 // A scalar that is keyframable (`value`) and optionally painted per vertex (`map`, multiplied).
 struct PaintedParam {
     fields::Param value{1.0};
@@ -39,11 +42,14 @@ struct PinRotation {
 
 // Pinned vertices, held at their initial positions moved rigidly by a keyframable rotation about
 // a pivot, then a keyframable translation (Houdini/Maya order: rotate about the pivot, then
-// translate): target(t) = pivot + R(t)(x_start − pivot) + translate(t).
+// translate): target(t) = pivot + R(t)(x_start − pivot) + translate(t). With `attach`, each
+// vertex is instead bound (when added) to its closest point on that mesh's first frame and
+// follows it (mesh_sequence.h, SurfaceBinding): an attachment, a hard constraint like a pin.
 struct PinSet {
     std::vector<int> vertices;
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
     PinRotation rotate;
+    std::shared_ptr<const MeshSequence> attach;
 };
 
 // Numerical settings of a body's substep.
@@ -232,6 +238,7 @@ private:
     std::vector<int> mPinned;             // vertex per pin
     std::vector<int> mPinSet;             // index into mPinSets per pin
     std::vector<PinSet> mPinSets;
+    std::vector<std::shared_ptr<const SurfaceBinding>> mPinBinding; // per pin: its attachment, or null
     VecX mAnchor;                         // 3 per pin: initial position
     std::vector<uint8_t> mHeld;           // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;

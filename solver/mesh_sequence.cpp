@@ -4,6 +4,7 @@
 
 #include "geometry/file_policy.h"
 #include "io/grid.h"
+#include "solver/contact/ccd.h"
 #include "solver/mesh.h"
 
 #include <cmath>
@@ -95,6 +96,59 @@ void MeshSequence::positionsAt(double t, std::vector<double>& out) const {
     const std::vector<double>& pb = mFrames[a + 1];
     out.resize(pa.size());
     for (size_t i = 0; i < pa.size(); ++i) out[i] = pa[i] + w * (pb[i] - pa[i]);
+}
+
+Vec3 MeshSequence::vertexAt(int v, double t) const {
+    const double f = t * mFps - static_cast<double>(mFirstFrame);
+    const long last = static_cast<long>(mFrames.size()) - 1;
+    if (last <= 0 || !(f > 0.0)) return vec3At(mFrames.front().data(), v);
+    if (f >= static_cast<double>(last)) return vec3At(mFrames.back().data(), v);
+    const long a = static_cast<long>(std::floor(f));
+    const double w = f - static_cast<double>(a);
+    const Vec3 pa = vec3At(mFrames[a].data(), v), pb = vec3At(mFrames[a + 1].data(), v);
+    return pa + w * (pb - pa);
+}
+
+namespace {
+// The triangle's frame (ê₁, n̂ × ê₁, n̂) as columns.
+Mat3 triangleFrame(const Vec3& a, const Vec3& b, const Vec3& c) {
+    Mat3 f = Mat3::Identity();
+    const Vec3 e = b - a, n = e.cross(c - a);
+    if (!(e.norm() > 0.0) || !(n.norm() > 0.0)) return f;
+    f.col(0) = e.normalized();
+    f.col(2) = n.normalized();
+    f.col(1) = f.col(2).cross(f.col(0));
+    return f;
+}
+} // namespace
+
+SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x) {
+    SurfaceBinding b;
+    double best = INFINITY;
+    const std::vector<double>& p = mesh.firstPositions();
+    for (size_t k = 0; k < mesh.triangles().size(); ++k) {
+        const auto& t = mesh.triangles()[k];
+        double w[3];
+        const double d2 = contact::pointTriangleDistance2(x, vec3At(p.data(), t[0]), vec3At(p.data(), t[1]),
+                                                          vec3At(p.data(), t[2]), w);
+        if (d2 < best) {
+            best = d2;
+            b.triangle = static_cast<int>(k);
+            std::copy(w, w + 3, b.w);
+        }
+    }
+    if (b.triangle < 0) return b;
+    const auto& t = mesh.triangles()[b.triangle];
+    const Vec3 a = vec3At(p.data(), t[0]), bb = vec3At(p.data(), t[1]), c = vec3At(p.data(), t[2]);
+    const Vec3 q = b.w[0] * a + b.w[1] * bb + b.w[2] * c;
+    b.local = triangleFrame(a, bb, c).transpose() * (x - q);
+    return b;
+}
+
+Vec3 boundPosition(const MeshSequence& mesh, const SurfaceBinding& b, double t) {
+    const auto& tri = mesh.triangles()[b.triangle];
+    const Vec3 a = mesh.vertexAt(tri[0], t), bb = mesh.vertexAt(tri[1], t), c = mesh.vertexAt(tri[2], t);
+    return b.w[0] * a + b.w[1] * bb + b.w[2] * c + triangleFrame(a, bb, c) * b.local;
 }
 
 } // namespace gale::solver

@@ -36,6 +36,8 @@ public:
     void positionsAt(double t, std::vector<double>& out) const;
     // The positions of the first frame (the bind pose of attachments).
     const std::vector<double>& firstPositions() const { return mFrames.front(); }
+    // One vertex at time t (the same interpolation as positionsAt).
+    Vec3 vertexAt(int v, double t) const;
 
 private:
     std::vector<std::array<int, 3>> mTriangles;
@@ -44,5 +46,18 @@ private:
     double mFps = 24.0;
     std::string mPath;
 };
+
+// A point bound to a mesh's surface (attachments): its closest triangle at the first frame,
+// the barycentric weights of the closest point q there, and the point's offset from q in the
+// triangle's frame (ê₁ along the first edge, n̂ the face normal, n̂ × ê₁), so that it follows
+// the triangle rigidly — exactly its own position at the bind frame, and q + offset·n̂ when it
+// lies over the face's interior.
+struct SurfaceBinding {
+    int triangle = -1;
+    double w[3] = {0, 0, 0};
+    Vec3 local = Vec3::Zero();
+};
+SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x);
+Vec3 boundPosition(const MeshSequence& mesh, const SurfaceBinding& b, double t);
 
 } // namespace gale::solver

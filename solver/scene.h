@@ -53,6 +53,11 @@ struct ClothSpec {
     PaintedSpec lift, drag;
     bool hasPins = false;
     PinSpec pins;
+    // attach = { mesh = "body.#.obj", box | vertices | map }: the selected vertices bound to the
+    // body's surface at its first frame (PinSet::attach).
+    bool hasAttach = false;
+    PinSpec attach;
+    std::string attachMesh; // resolved
     StepOptions step;
     std::string output = "obj"; // obj | ply
     int line = 0, col = 0;
@@ -69,6 +74,10 @@ struct HairSpec {
     Vec3 direction = -Vec3::UnitY();
     HairMaterial material;
     PaintedSpec dragNormal, dragTangent;
+    // attach = { mesh = "scalp.#.obj", box = [...] (optional) }: roots bound to the surface.
+    bool hasAttach = false;
+    PinSpec attach;
+    std::string attachMesh; // resolved
     StepOptions step;
     std::string output = "obj";
     int line = 0, col = 0;
