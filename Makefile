@@ -10,7 +10,7 @@ DEMO_OUT  := $(BUILD)/demo
 DEB_PACKAGES := g++ cmake ninja-build pkg-config make \
 	libeigen3-dev libfftw3-dev libgsl-dev libopenvdb-dev libboost-iostreams-dev \
 	libtbb-dev catch2 libcli11-dev libtomlplusplus-dev libtinyobjloader-dev \
-	libcairo2-dev libpng-dev parallel
+	libcairo2-dev libpng-dev parallel python3
 
 .PHONY: all deps configure build demo test test-asan test-tsan fuzz bench report clean format
 
