@@ -148,8 +148,8 @@ int main(int argc, char** argv) {
                 "unresolved |\n"
                 "|---|---|---|---|---|---|\n");
     const Sphere ball = sphere(0.2, 5000);
-    for (double th : {0.002, 0.005, 0.01, 0.02})
-        for (int sub : {1, 2, 4, 8}) {
+    for (double th : {0.002, 0.005, 0.02})
+        for (int sub : {1, 2, 4}) {
             const Run r = ballRun(ball, 32, sub, th, frames, true);
             std::printf("| %.3f | %d | %.2f | %.4f | %.2f | %lld |\n", th, sub,
                         1e3 * r.secondsPerFrame, r.closest, r.closest / th, r.stats.unresolved);

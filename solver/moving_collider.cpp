@@ -136,8 +136,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // needs less); hits are placed at the full thickness, so that a re-check of the corrected
     // motion has half the thickness to spare (no re-hit on resting contact), and the push-out
     // after it (Body::resolveContacts) restores the full thickness everywhere else.
+    // Already within the thickness at the start (resting contact): only crossing is caught
+    // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
     contact::CcdOptions opt;
     opt.thickness = 0.5 * thickness;
+    opt.shrinkWithinThickness = true;
+    std::vector<int> cand;
     std::vector<uint8_t> moved(n, 0);
     int movedCount = 0;
     // The velocity response at vertex i against a surface point moving at vs, normal n1.
@@ -178,24 +182,17 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             q.inflate(thickness);
             double first = 2.0;
             int hitTri = -1;
-            std::vector<int> cand;
+            cand.clear();
             mBvh.query(q, [&](int k) { cand.push_back(k); });
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
             for (int k : cand) {
                 const auto& t = tris[k];
-                double toi, w[3];
-                // Already within the thickness at the start (resting contact): only crossing is
-                // caught here (ξ halved to the start distance), the push-out restores ξ, so a
-                // vertex that leaves is not held back.
-                contact::CcdOptions o = opt;
-                const double d0 = std::sqrt(contact::pointTriangleDistance2(
-                    p0, corner(false, t[0]), corner(false, t[1]), corner(false, t[2]), w));
-                if (d0 <= opt.thickness) o.thickness = 0.5 * d0;
+                double toi;
                 if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
                                                corner(false, t[1]), corner(true, t[1]),
-                                               corner(false, t[2]), corner(true, t[2]), o, toi) &&
+                                               corner(false, t[2]), corner(true, t[2]), opt, toi) &&
                     toi < first) {
                     first = toi;
                     hitTri = k;
@@ -242,7 +239,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             q.add(b0);
             q.add(b1);
             q.inflate(thickness);
-            std::vector<int> cand;
+            cand.clear();
             mBvh.query(q, [&](int k) {
                 for (int c = 0; c < 3; ++c) cand.push_back(mTriEdges[k][c]);
             });
@@ -255,13 +252,9 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             int hitEdge = -1;
             for (int k : cand) {
                 const int r = mEdges[k][0], s = mEdges[k][1];
-                double toi, u0, u1;
-                contact::CcdOptions o = opt;
-                const double d0 = std::sqrt(contact::segmentSegmentDistance2(
-                    a0, b0, corner(false, r), corner(false, s), u0, u1));
-                if (d0 <= opt.thickness) o.thickness = 0.5 * d0;
+                double toi;
                 if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
-                                         corner(false, s), corner(true, s), o, toi) &&
+                                         corner(false, s), corner(true, s), opt, toi) &&
                     toi < first) {
                     first = toi;
                     hitEdge = k;

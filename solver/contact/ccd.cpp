@@ -126,8 +126,9 @@ bool accd(Vec3 x[4], Vec3 dx[4], int firstCount, const CcdOptions& opt, Dist2 di
         scale = std::max(scale, x[i].cwiseAbs().maxCoeff());
     }
     const double lp = (la + lb) * (1.0 + 1e-12);
-    const double xi = opt.thickness;
+    double xi = opt.thickness;
     double d = std::sqrt(dist2(x));
+    if (opt.shrinkWithinThickness && d <= xi) xi = 0.5 * d;
     toi = 0.0;
     if (!(d > xi + 1e-12 * scale)) return true; // within the thickness at the start
     if (!(lp > 0.0)) return false;              // no relative motion: the distance is constant

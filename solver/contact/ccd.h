@@ -32,6 +32,10 @@ struct CcdOptions {
     // keeps every reached time clear of contact).
     double stepFraction = 0.9;
     int maxIterations = 500; // then report a contact at the time reached (conservative)
+    // Primitives that start within the thickness: true — only keep them from crossing (ξ becomes
+    // half their start distance, so a pair in resting contact that separates is no hit); false —
+    // report contact at t = 0.
+    bool shrinkWithinThickness = false;
 };
 
 // The motion of a primitive's corners over the step t ∈ [0, 1]: x(t) = x0 + t (x1 − x0).

@@ -67,6 +67,15 @@ TEST_CASE("ccd: vertex against triangle, degenerate cases", "[contact][ccd]") {
     REQUIRE(
         vertexTriangleCcd(Vec3(0.2, 0.2, 0.005), Vec3(0.2, 0.2, 0.5), A, A, B, B, C, C, o, toi));
     CHECK(toi == 0.0);
+    // ... unless only crossing is asked for (resting contact): leaving is no hit, crossing is.
+    CcdOptions shrink = o;
+    shrink.shrinkWithinThickness = true;
+    CHECK_FALSE(vertexTriangleCcd(Vec3(0.2, 0.2, 0.005), Vec3(0.2, 0.2, 0.5), A, A, B, B, C, C,
+                                  shrink, toi));
+    REQUIRE(vertexTriangleCcd(Vec3(0.2, 0.2, 0.005), Vec3(0.2, 0.2, -0.5), A, A, B, B, C, C, shrink,
+                              toi));
+    CHECK(toi > 0.0);
+    CHECK(toi <= 0.0025 / 0.505);
     // Contact exactly at t = 1: the triangle arrives at distance ξ of a static point.
     const Vec3 dz(0, 0, 1);
     REQUIRE(vertexTriangleCcd(Vec3(0.2, 0.2, 0.01), Vec3(0.2, 0.2, 0.01), A - dz, A, B - dz, B,
