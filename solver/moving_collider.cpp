@@ -175,6 +175,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
         for (size_t i = 0; i < n; ++i) {
             if (!movable[i]) continue;
             const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
+            if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
             q.add(p0);
@@ -232,6 +233,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!movable[i] && !movable[j]) continue;
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
+            if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
             q.add(a0);
