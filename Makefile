@@ -11,7 +11,7 @@ DEB_PACKAGES := g++ cmake ninja-build pkg-config make \
 	libeigen3-dev libfftw3-dev libgsl-dev libopenvdb-dev libboost-iostreams-dev \
 	libtbb-dev catch2 libcli11-dev libtomlplusplus-dev libtinyobjloader-dev \
 	libcairo2-dev libpng-dev parallel \
-	pybind11-dev python3-dev python3-numpy python3-pytest
+	pybind11-dev python3-dev python3-numpy python3-pytest python3
 
 .PHONY: all deps configure build demo test test-asan test-tsan fuzz bench report clean format
 

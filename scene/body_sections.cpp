@@ -6,6 +6,7 @@
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 #include "solver/mesh_collider.h"
+#include "solver/moving_collider.h"
 #include "solver/scene.h"
 
 #include "lang/functions.h"
@@ -39,10 +40,10 @@ std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
 }
 const std::vector<std::string> kClothKeys =
     withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
-                  "drag", "aero_model", "aero_jacobian"});
+                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh", "attach"});
 const std::vector<std::string> kHairKeys =
     withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
-                  "drag_normal", "drag_tangent", "root_pinned"});
+                  "drag_normal", "drag_tangent", "root_pinned", "rest_shape", "attach"});
 const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
                                                 "a", "b", "thickness", "friction", "mesh", "voxel"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
@@ -65,12 +66,14 @@ private:
     bool numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out);
     std::optional<fields::Param> param(const toml::node& n, const std::string& what, int width, double min);
     bool painted(const toml::node& n, const std::string& what, const std::string& baseDir, PaintedSpec& out);
-    bool pins(const toml::node& n, const std::string& what, PinSpec& out);
+    bool pins(const toml::node& n, const std::string& what, PinSpec& out, bool attachKeys = false);
+    bool attach(const toml::node& n, const std::string& what, const std::string& baseDir, bool needSelection,
+                PinSpec& out, std::string& meshPath);
     void stepOptions(const toml::table& t, const std::string& what, StepOptions& s, std::string& output);
 
     void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
     void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
-    void loadCollider(const toml::table& t, size_t index, Collider& c);
+    void loadCollider(const toml::table& t, size_t index, double fps, Collider& c);
     void loadSolver(const toml::table& t, SolverSection& s);
 };
 
@@ -237,7 +240,7 @@ bool Loader::painted(const toml::node& n, const std::string& what, const std::st
     return ok;
 }
 
-bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
+bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out, bool attachKeys) {
     out.line = static_cast<int>(n.source().begin.line);
     out.col = static_cast<int>(n.source().begin.column);
     const toml::table* t = n.as_table();
@@ -246,7 +249,10 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
                         "{ box = [x0, y0, z0, x1, y1, z1] }, not " + tomlTypeName(n));
         return false;
     }
-    checkKeys(*t, {"vertices", "map", "box", "translate"}, what);
+    if (attachKeys)
+        checkKeys(*t, {"mesh", "vertices", "map", "box"}, what);
+    else
+        checkKeys(*t, {"vertices", "map", "box", "translate", "rotate"}, what);
     bool ok = true;
     if (const toml::node* v = t->get("vertices")) {
         const toml::array* a = v->as_array();
@@ -284,6 +290,76 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out) {
         else
             ok = false;
     }
+    // rotate = { pivot = [x, y, z], axis = [x, y, z], angle = degrees | { keys = [[t, deg], ...] } }
+    if (const toml::node* r = t->get("rotate")) {
+        const toml::table* rt = r->as_table();
+        if (!rt) {
+            error(*r, what + ": rotate must be a table { pivot = [x, y, z], axis = [x, y, z], angle = degrees or keys }, not " +
+                          tomlTypeName(*r));
+            return false;
+        }
+        checkKeys(*rt, {"pivot", "axis", "angle"}, what + " rotate");
+        out.rotate.active = true;
+        if (const toml::node* n = rt->get("pivot")) ok = vec3(*n, what + ": rotate pivot", out.rotate.pivot) && ok;
+        if (const toml::node* n = rt->get("axis")) {
+            if (vec3(*n, what + ": rotate axis", out.rotate.axis)) {
+                if (!(out.rotate.axis.norm() > 0.0)) {
+                    error(*n, what + ": rotate axis must not be zero");
+                    ok = false;
+                }
+            } else {
+                ok = false;
+            }
+        }
+        if (const toml::node* n = rt->get("angle")) {
+            std::optional<fields::Param> p = param(*n, what + ": rotate angle (degrees)", 1, -1e300);
+            if (p)
+                out.rotate.angle = *p;
+            else
+                ok = false;
+        } else {
+            error(*r, what + ": rotate needs angle = degrees or { keys = [[t0, deg0], [t1, deg1]] }");
+            ok = false;
+        }
+    }
+    return ok;
+}
+
+// attach = { mesh = "body.#.obj", vertices | map | box }: the selection keys of pins.
+bool Loader::attach(const toml::node& n, const std::string& what, const std::string& baseDir, bool needSelection,
+                    PinSpec& out, std::string& meshPath) {
+    out.line = static_cast<int>(n.source().begin.line);
+    out.col = static_cast<int>(n.source().begin.column);
+    const toml::table* t = n.as_table();
+    if (!t) {
+        error(n, what + " must be a table { mesh = \"body.#.obj\", box = [x0, y0, z0, x1, y1, z1] }, not " +
+                     tomlTypeName(n));
+        return false;
+    }
+    bool ok = true;
+    const toml::node* m = t->get("mesh");
+    std::string file;
+    if (!m) {
+        error(n, what + " needs mesh = \"file\" (the body to attach to: OBJ/PLY, or a '#' sequence)");
+        ok = false;
+    } else if (string(*m, what + ": mesh", file)) {
+        meshPath = std::filesystem::path(file).is_absolute()
+                       ? file
+                       : (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    } else {
+        ok = false;
+    }
+    if (!t->get("vertices") && !t->get("map") && !t->get("box")) {
+        if (needSelection) {
+            error(n, what + " needs vertices = [...], map = \"property\" or box = [x0, y0, z0, x1, y1, z1]");
+            ok = false;
+        }
+        return ok;
+    }
+    const int line = out.line, col = out.col;
+    ok = pins(n, what, out, true) && ok; // the selection keys, read as for pins
+    out.line = line;
+    out.col = col;
     return ok;
 }
 
@@ -389,6 +465,18 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
             c.step.aeroJacobian = v == "paper" ? AeroJacobian::Paper : AeroJacobian::Projected;
     }
     if (const toml::node* n = t.get("pins")) c.hasPins = pins(*n, what + " pins", c.pins);
+    if (const toml::node* n = t.get("attach"))
+        c.hasAttach = attach(*n, what + " attach", baseDir, true, c.attach, c.attachMesh);
+    if (const toml::node* n = t.get("rest_shape")) choice(*n, "rest_shape", {"mesh", "flat"}, c.restShape);
+    if (const toml::node* n = t.get("rest_mesh")) {
+        std::string file;
+        c.restLine = static_cast<int>(n->source().begin.line);
+        c.restCol = static_cast<int>(n->source().begin.column);
+        if (!mesh)
+            error(*n, what + ": rest_mesh needs mesh = \"file\" (the rest shape of a loaded mesh; a grid is flat)");
+        else if (string(*n, what + ": rest_mesh", file))
+            c.restMeshPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+    }
     stepOptions(t, what, c.step, c.output);
 }
 
@@ -464,12 +552,21 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
     if (const toml::node* n = t.get("drag_normal")) painted(*n, what + ": drag_normal", baseDir, h.dragNormal);
     if (const toml::node* n = t.get("drag_tangent")) painted(*n, what + ": drag_tangent", baseDir, h.dragTangent);
     if (const toml::node* n = t.get("root_pinned")) boolean(*n, what + ": root_pinned", h.material.rootPinned);
+    // Bending rest shape: the strand's own polyline (a curl; the default for loaded strands) or
+    // straight (the default for generated ones, which are straight anyway).
+    h.material.curledRest = strands != nullptr;
+    if (const toml::node* n = t.get("rest_shape")) {
+        std::string v;
+        if (choice(*n, "rest_shape", {"strand", "straight"}, v)) h.material.curledRest = v == "strand";
+    }
+    if (const toml::node* n = t.get("attach"))
+        h.hasAttach = attach(*n, what + " attach", baseDir, false, h.attach, h.attachMesh);
     if (const toml::node* n = t.get("pins"))
         error(*n, what + ": strands are pinned at their roots (root_pinned = true); pins maps are for cloth");
     stepOptions(t, what, h.step, h.output);
 }
 
-void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
+void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collider& c) {
     c.name = "collider" + std::to_string(index);
     if (const toml::node* n = t.get("name")) string(*n, "[[collider]] name", c.name);
     const std::string what = "[[collider]] '" + c.name + "'";
@@ -523,6 +620,17 @@ void Loader::loadCollider(const toml::table& t, size_t index, Collider& c) {
     const std::string path = p.is_absolute() ? file
                              : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
     std::string problem;
+    if (path.find('#') != std::string::npos) {
+        // A per-frame sequence: triangles, a refitted tree and continuous contact
+        // (solver/moving_collider.h) instead of an SDF rebuilt every frame.
+        std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, fps, problem);
+        if (!seq) {
+            error(*mesh, what + ": " + problem);
+            return;
+        }
+        c.moving = std::make_shared<MovingMeshContact>(std::move(seq));
+        return;
+    }
     c.mesh = MeshCollider::load(path, voxel, problem);
     if (!c.mesh) error(*mesh, what + ": " + problem);
 }
@@ -568,7 +676,7 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
     });
     list("collider", [&](const toml::table& t, size_t i) {
         Collider c;
-        loadCollider(t, i, c);
+        loadCollider(t, i, out.wind.settings.fps, c);
         out.colliders.push_back(std::move(c));
     });
     if (const toml::node* n = root.get("solver")) {

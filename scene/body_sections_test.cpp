@@ -294,3 +294,152 @@ TEST_CASE("scene: keyframed body values go through the one keyframe parser", "[s
     CHECK(twice.all().find(":4:28: error: [[cloth]] 'c': drag: two keys at time 0") !=
           std::string::npos);
 }
+
+TEST_CASE("scene: pins rotate about a pivot, with keyed degrees", "[scene]") {
+    TempDir dir;
+    Loaded l = load(dir, R"(
+[scene]
+fps = 24
+frames = [1, 2]
+
+[[cloth]]
+name = "flag"
+grid = { size = [1.0, 1.0], res = [4, 4] }
+pins = { box = [-0.1, -0.1, -1, 0.1, 1.1, 1], rotate = { pivot = [0, 0, 0], axis = [0, 1, 0], angle = { keys = [[0, 0], [1, 90]] } } }
+)");
+    INFO(l.all());
+    REQUIRE(l.ok);
+    const PinSpec& p = l.scene.cloths[0].pins;
+    CHECK(p.rotate.active);
+    CHECK(p.rotate.axis == Vec3::UnitY());
+    CHECK(p.rotate.angle.scalarAt(0.5) == Approx(45.0));
+    std::vector<std::unique_ptr<Body>> bodies;
+    std::vector<gale::fields::SceneError> errors;
+    std::vector<std::string> warnings;
+    REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
+    // Vertex 4 is at (0, 1/3, 0) on the pivot's axis: it does not move; none is off it here, so
+    // check a point off the axis through the rigid motion instead.
+    REQUIRE(bodies[0]->pinnedVertices().size() == 4);
+    CHECK((bodies[0]->pinTarget(1, 1.0) - bodies[0]->pinTarget(1, 0.0)).norm() < 1e-12);
+
+    Loaded bad = load(dir, R"(
+[[cloth]]
+grid = { size = [1.0, 1.0], res = [4, 4] }
+pins = { vertices = [0], rotate = { axis = [0, 0, 0] } }
+)");
+    CHECK_FALSE(bad.ok);
+    CHECK(bad.all().find("rotate axis must not be zero") != std::string::npos);
+    CHECK(bad.all().find("rotate needs angle") != std::string::npos);
+    CHECK(bad.all().find(":4:") != std::string::npos);
+}
+
+TEST_CASE("scene: rest_shape and rest_mesh", "[scene][rest]") {
+    TempDir dir;
+    // A sheet folded 90° along its middle edge: start pose flat, rest pose folded.
+    dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n");
+    dir.write("fold.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 1\nf 1 2 3\nf 2 4 3\n");
+    dir.write("fewer.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    Loaded l = load(dir, R"(
+[[cloth]]
+name = "a"
+mesh = "flat.obj"
+rest_mesh = "fold.obj"
+
+[[cloth]]
+name = "b"
+mesh = "fold.obj"
+rest_shape = "flat"
+)");
+    INFO(l.all());
+    REQUIRE(l.ok);
+    std::vector<std::unique_ptr<Body>> bodies;
+    std::vector<gale::fields::SceneError> errors;
+    std::vector<std::string> warnings;
+    REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
+    // a: starts flat (its positions), rest folded: bending energy > 0 at the start; the rest
+    // lengths are the fold's, so the diagonal 2-3 (√2 in both) is unstretched.
+    CHECK(bodies[0]->positions()[11] == 0.0);
+    CHECK(bodies[0]->elasticEnergy(0.0) > 0.0);
+    // b: a folded mesh with a flat rest costs the fold's energy; with the default ("mesh") none.
+    CHECK(bodies[1]->elasticEnergy(0.0) > 0.0);
+    Loaded d = load(dir, "[[cloth]]\nmesh = \"fold.obj\"\n");
+    REQUIRE(d.ok);
+    bodies.clear();
+    REQUIRE(buildBodies(d.scene, bodies, errors, warnings));
+    CHECK(bodies[0]->elasticEnergy(0.0) == Approx(0.0).margin(1e-15));
+
+    Loaded bad = load(dir, "[[cloth]]\nmesh = \"flat.obj\"\nrest_mesh = \"fewer.obj\"\n");
+    REQUIRE(bad.ok);
+    bodies.clear();
+    errors.clear();
+    CHECK_FALSE(buildBodies(bad.scene, bodies, errors, warnings));
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].render().find("fewer.obj") != std::string::npos);
+    CHECK(errors[0].render().find("3 vertices and 1 triangles against 4 and 2") != std::string::npos);
+    CHECK(errors[0].line == 3);
+    Loaded grid = load(dir, "[[cloth]]\ngrid = { size = [1, 1], res = [3, 3] }\nrest_mesh = \"fold.obj\"\n");
+    CHECK_FALSE(grid.ok);
+    CHECK(grid.all().find("rest_mesh needs mesh") != std::string::npos);
+}
+
+TEST_CASE("scene: moving mesh colliders and attachments from a '#' sequence", "[scene][attach]") {
+    TempDir dir;
+    // A unit square plate in y = 0 moving up 0.1 m per frame, frames 1..3.
+    for (int f = 1; f <= 3; ++f) {
+        const std::string y = std::to_string(0.1 * (f - 1));
+        dir.write("plate.000" + std::to_string(f) + ".obj",
+                  "v -1 " + y + " -1\nv 1 " + y + " -1\nv 1 " + y + " 1\nv -1 " + y + " 1\nf 1 2 3\nf 1 3 4\n");
+    }
+    Loaded l = load(dir, R"(
+[scene]
+fps = 10
+frames = [1, 3]
+
+[[cloth]]
+name = "sheet"
+grid = { size = [0.5, 0.5], res = [3, 3], origin = [-0.25, 0.01, -0.25], axes = "xz" }
+attach = { mesh = "plate.#.obj", box = [-1, -1, -1, 0, 1, 1] }
+
+[[hair]]
+name = "tuft"
+grid = { size = [0.1, 0.1], count = [2, 2], length = 0.1, segments = 2, origin = [0, 0.002, 0], direction = [0, 1, 0] }
+attach = { mesh = "plate.#.obj" }
+
+[[collider]]
+name = "plate"
+type = "mesh"
+mesh = "plate.#.obj"
+)");
+    INFO(l.all());
+    REQUIRE(l.ok);
+    REQUIRE(l.scene.colliders.size() == 1);
+    CHECK(l.scene.colliders[0].moving);
+    CHECK(!l.scene.colliders[0].mesh);
+    std::vector<std::unique_ptr<Body>> bodies;
+    std::vector<gale::fields::SceneError> errors;
+    std::vector<std::string> warnings;
+    REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
+    // Cloth: the 6 vertices with x ≤ 0, 1 cm above the plate, following it up (frame 3 at t = 0.3).
+    REQUIRE(bodies[0]->pinnedVertices().size() == 6);
+    for (size_t k = 0; k < 6; ++k) {
+        const Vec3 p0 = bodies[0]->pinTarget(k, 0.1), p1 = bodies[0]->pinTarget(k, 0.3);
+        CHECK(p0.y() == Approx(0.01));
+        CHECK(p1.y() == Approx(0.21));
+        CHECK(bodies[0]->pinVelocity(k, 0.15).y() == Approx(1.0)); // 0.1 m per frame at 10 fps
+    }
+    // Hair: all four roots attached.
+    REQUIRE(bodies[1]->pinnedVertices().size() == 4);
+    CHECK(bodies[1]->pinTarget(0, 0.3).y() == Approx(0.202));
+
+    Loaded bad = load(dir, R"(
+[[cloth]]
+grid = { size = [0.5, 0.5], res = [3, 3] }
+attach = { mesh = "plate.#.obj", translate = [0, 1, 0] }
+)");
+    CHECK_FALSE(bad.ok);
+    CHECK(bad.all().find("translate") != std::string::npos);
+    CHECK(bad.all().find("needs vertices") != std::string::npos);
+    Loaded missing = load(dir, "[[collider]]\ntype = \"mesh\"\nmesh = \"nothing.#.obj\"\n");
+    CHECK_FALSE(missing.ok);
+    CHECK(missing.all().find("nothing.#.obj") != std::string::npos);
+}

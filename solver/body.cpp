@@ -7,6 +7,8 @@
 // solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
 // same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
 #include "solver/body.h"
+#include "solver/mesh_sequence.h"
+#include "solver/moving_collider.h"
 
 #include <algorithm>
 #include <cmath>
@@ -74,16 +76,50 @@ void Body::addPins(const PinSet& pins) {
         if (std::find(mPinned.begin(), mPinned.end(), v) != mPinned.end()) continue;
         mPinned.push_back(v);
         mPinSet.push_back(set);
+        mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
+                                  ? std::make_shared<const SurfaceBinding>(bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                  : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
         mAnchor.tail<3>() = p;
     }
 }
 
+namespace {
+Vec3 translationAt(const fields::Param& p, double t) {
+    double d[3] = {0.0, 0.0, 0.0};
+    if (p.width() >= 3) p.evaluate(t, d);
+    return Vec3(d[0], d[1], d[2]);
+}
+// The rotation of a PinRotation at t (identity when inactive or about a zero axis).
+Mat3 rotationAt(const PinRotation& r, double t) {
+    if (!r.active || !(r.axis.norm() > 0.0)) return Mat3::Identity();
+    const double rad = r.angle.scalarAt(t) * (M_PI / 180.0);
+    return Eigen::AngleAxisd(rad, r.axis.normalized()).toRotationMatrix();
+}
+} // namespace
+
 Vec3 Body::pinTarget(size_t k, double t) const {
-    const std::vector<double> d = mPinSets[mPinSet[k]].translate.at(t);
-    Vec3 off = d.size() >= 3 ? Vec3(d[0], d[1], d[2]) : Vec3::Zero();
-    return mAnchor.segment<3>(3 * k) + off;
+    const PinSet& set = mPinSets[mPinSet[k]];
+    if (mPinBinding[k]) return boundPosition(*set.attach, *mPinBinding[k], t);
+    const Vec3 anchor = mAnchor.segment<3>(3 * k);
+    const Vec3 rotated = set.rotate.active ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
+                                           : anchor;
+    return rotated + translationAt(set.translate, t);
+}
+
+Vec3 Body::pinVelocity(size_t k, double t) const {
+    const PinSet& set = mPinSets[mPinSet[k]];
+    constexpr double d = 1e-6; // s: the right derivative (the motion ahead), exact on linear keys
+    if (mPinBinding[k]) return (pinTarget(k, t + d) - pinTarget(k, t)) / d;
+    Vec3 v = (translationAt(set.translate, t + d) - translationAt(set.translate, t)) / d;
+    if (set.rotate.active && set.rotate.axis.norm() > 0.0) {
+        const double omega = (set.rotate.angle.scalarAt(t + d) - set.rotate.angle.scalarAt(t)) / d *
+                             (M_PI / 180.0); // rad/s
+        const Vec3 r = rotationAt(set.rotate, t) * (mAnchor.segment<3>(3 * k) - set.rotate.pivot);
+        v += (omega * set.rotate.axis.normalized()).cross(r);
+    }
+    return v;
 }
 
 void Body::restore(const Snapshot& s) {
@@ -163,6 +199,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     if (!env.colliders || env.colliders->empty()) return;
     const size_t n = vertexCount();
     for (const Collider& c : *env.colliders) {
+        if (c.moving) c.moving->prepare(t, t + h, c.thickness); // the step's tree (moving_collider.h)
         const ColliderPose pose = colliderPose(c, t);
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1) continue; // pinned or held
@@ -195,6 +232,7 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
             const ContactPoint cp = queryCollider(pose, x);
             const bool held = mContactCollider[i] == static_cast<int>(&c - env.colliders->data());
+            if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
             if (!(cp.distance < c.thickness) && !held) continue;
             touched[i] = 1;
             if (cp.distance < c.thickness) x += (c.thickness - cp.distance) * cp.normal;
@@ -722,7 +760,15 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     mV = v0 + mDv;
     mX = x0 + h * mV;
 
-    // 6. Colliders: push out, remove approach speed, Coulomb friction.
+    // 6. Colliders: moving meshes first swept continuously over the step (no vertex or edge
+    // crosses the surface, moving_collider.h), then push out, approach speed, Coulomb friction.
+    if (env.colliders)
+        for (const Collider& c : *env.colliders)
+            if (c.moving) {
+                std::vector<uint8_t> movable(n);
+                for (size_t i = 0; i < n; ++i) movable[i] = mConstraints.kind[i] != 1;
+                c.moving->sweep(x0, mX, mV, movable, mEdges, c.thickness, c.friction, h);
+            }
     st.contacts = resolveContacts(env, t + h, h);
 
     // 7. Trouble detection.

@@ -17,6 +17,9 @@
 
 namespace gale::solver {
 
+class MeshSequence; // solver/mesh_sequence.h
+struct SurfaceBinding;
+
 // A scalar that is keyframable (`value`) and optionally painted per vertex (`map`, multiplied).
 struct PaintedParam {
     fields::Param value{1.0};
@@ -28,10 +31,25 @@ struct PaintedParam {
     bool alwaysZero() const;
 };
 
-// Pinned vertices, held at their initial positions plus a keyframable translation.
+// A keyframable rotation of pinned vertices by `angle` (degrees, right-handed) about the line
+// through `pivot` along `axis` (world space, fixed).
+struct PinRotation {
+    bool active = false;
+    Vec3 pivot = Vec3::Zero();
+    Vec3 axis = Vec3::UnitY();
+    fields::Param angle{0.0}; // degrees, scalar keys
+};
+
+// Pinned vertices, held at their initial positions moved rigidly by a keyframable rotation about
+// a pivot, then a keyframable translation (Houdini/Maya order: rotate about the pivot, then
+// translate): target(t) = pivot + R(t)(x_start − pivot) + translate(t). With `attach`, each
+// vertex is instead bound (when added) to its closest point on that mesh's first frame and
+// follows it (mesh_sequence.h, SurfaceBinding): an attachment, a hard constraint like a pin.
 struct PinSet {
     std::vector<int> vertices;
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
+    PinRotation rotate;
+    std::shared_ptr<const MeshSequence> attach;
 };
 
 // Numerical settings of a body's substep.
@@ -162,6 +180,10 @@ public:
     const std::vector<int>& pinnedVertices() const { return mPinned; }
     // Pin target position of vertex index `k` in pinnedVertices() at time t.
     Vec3 pinTarget(size_t k, double t) const;
+    // Its velocity d/dt of the rigid motion at t (m/s): ω × R(x_start − pivot) + d(translate)/dt,
+    // the key curves' right derivatives (over 1e-6 s). The substep itself moves a pin along the
+    // chord (target(t + h) − x₀)/h, so that x₁ lands exactly on the motion (backward Euler).
+    Vec3 pinVelocity(size_t k, double t) const;
 
     // One linearised backward-Euler substep from t to t + h. Updates the state even when the
     // status reports trouble: the caller keeps a snapshot and decides.
@@ -233,6 +255,7 @@ private:
     std::vector<int> mPinned;             // vertex per pin
     std::vector<int> mPinSet;             // index into mPinSets per pin
     std::vector<PinSet> mPinSets;
+    std::vector<std::shared_ptr<const SurfaceBinding>> mPinBinding; // per pin: its attachment, or null
     VecX mAnchor;                         // 3 per pin: initial position
     std::vector<uint8_t> mHeld;           // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;

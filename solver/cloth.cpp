@@ -120,7 +120,8 @@ Cloth::Cloth(std::string name, TriMesh mesh, ClothMaterial material, const VecX*
     for (size_t h = 0; h < mHinges.size(); ++h) {
         Vec3 p[4];
         for (int k = 0; k < 4; ++k) p[k] = vec3At(x, mHinges[h].v[k]);
-        makeHingeRest(p, mHingeRest[h]);
+        if (makeHingeRest(p, mHingeRest[h]) && mMat.curvedRest) setHingeRestShape(p, mHingeRest[h]);
+        if (mHingeRest[h].bent.squaredNorm() > 0.0) mCurved = true;
     }
     auto triMean = [&](const std::vector<double>& map, std::vector<double>& out) {
         out.clear();
@@ -304,6 +305,11 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                 for (int a = 0; a < 4; ++a) {
                     s += r.k[a] * vec3At(in.x, v[a]);
                     sv += r.k[a] * vec3At(in.v, v[a]);
+                }
+                if (mCurved) { // s − r(x): the rest s̄ carried into the current hinge frame
+                    const Vec3 p[4] = {vec3At(in.x, v[0]), vec3At(in.x, v[1]), vec3At(in.x, v[2]),
+                                       vec3At(in.x, v[3])};
+                    s -= hingeFrame(p) * r.bent;
                 }
                 mHingeEnergy[hi] = 0.5 * c * s.squaredNorm();
                 // f_a −= c k_a (s + β ṡ), (K v)_a += c k_a ṡ.

@@ -18,6 +18,9 @@ struct ClothMaterial {
     PaintedParam lift;                 // C_L (value × map)
     PaintedParam drag;                 // C_D
     AeroModel aeroModel = AeroModel::Frozen;
+    // Bending rest angles: false — flat (Bergou et al.); true — the rest mesh's own dihedral
+    // angles (rest_shape = "mesh", elastic.h setHingeRestShape).
+    bool curvedRest = false;
     ClothMaterial() {
         lift.value = fields::Param(0.3);
         drag.value = fields::Param(1.0);
@@ -57,6 +60,7 @@ private:
     ColouredBlocks mTriBlocks, mHingeBlocks;
     std::vector<double> mTriEnergy, mHingeEnergy; // per element, summed in element order
     int mDegenerate = 0;
+    bool mCurved = false; // some hinge has a non-flat rest shape
 };
 
 } // namespace gale::solver

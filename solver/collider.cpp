@@ -1,6 +1,7 @@
 // Signed distances of the analytic colliders and their surface velocities.
 #include "solver/collider.h"
 #include "solver/mesh_collider.h"
+#include "solver/moving_collider.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +35,11 @@ ColliderPose colliderPose(const Collider& c, double t) {
     p.normal = nn > 0.0 ? Vec3(p.normal / nn) : Vec3::UnitY();
     p.radius = c.radius;
     p.mesh = c.mesh.get();
+    if (c.moving) {
+        p.moving = c.moving.get();
+        p.atEnd = !(t <= c.moving->t0());
+        p.searchRadius = 2.0 * c.thickness + 1e-3;
+    }
     return p;
 }
 
@@ -69,7 +75,8 @@ ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x) {
         break;
     }
     case ColliderShape::Mesh:
-        if (pose.mesh) pose.mesh->query(x, cp.distance, cp.normal);
+        if (pose.moving) pose.moving->closest(x, pose.atEnd, pose.searchRadius, cp); // inf when far
+        else if (pose.mesh) pose.mesh->query(x, cp.distance, cp.normal);
         else cp.distance = 1e30; // not loaded: never touches
         break;
     }

@@ -10,7 +10,8 @@
 
 namespace gale::solver {
 
-class MeshCollider; // solver/mesh_collider.h
+class MeshCollider;      // solver/mesh_collider.h
+class MovingMeshContact; // solver/moving_collider.h
 
 enum class ColliderShape { Plane, Sphere, Capsule, Mesh };
 
@@ -26,6 +27,9 @@ struct Collider {
     double thickness = 0.005; // m: vertices are kept this far outside the surface
     double friction = 0.3;  // Coulomb coefficient μ (dimensionless)
     std::shared_ptr<const MeshCollider> mesh; // Mesh: the body's SDF (static)
+    // Mesh from a moving sequence (`mesh = "body.#.obj"`): its triangles, tree and CCD (shared
+    // state, prepared per substep; then `mesh` is null).
+    std::shared_ptr<MovingMeshContact> moving;
 };
 
 // A contact query: signed distance to the surface (m, negative inside), the outward unit
@@ -43,6 +47,9 @@ struct ColliderPose {
     Vec3 velA = Vec3::Zero(), velB = Vec3::Zero(); // m/s of a and b (finite difference of keys)
     double radius = 0.0;
     const MeshCollider* mesh = nullptr;
+    const MovingMeshContact* moving = nullptr; // at the start (atEnd false) or end of its step
+    bool atEnd = false;
+    double searchRadius = 0.0; // m: how far a moving mesh is searched for the closest point
 };
 ColliderPose colliderPose(const Collider& c, double t);
 

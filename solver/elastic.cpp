@@ -147,6 +147,38 @@ void springForces(const Vec3& x0, const Vec3& x1, double restLength, double ea, 
     out.K = k * (u * u.transpose() + t * (Mat3::Identity() - u * u.transpose()));
 }
 
+Mat3 hingeFrame(const Vec3 x[4]) {
+    const Vec3 e = x[1] - x[0];
+    const Vec3 n0 = e.cross(x[2] - x[0]), n1 = (x[3] - x[0]).cross(e); // same side when flat
+    const double l0 = n0.norm(), l1 = n1.norm(), le = e.norm();
+    Mat3 f = Mat3::Identity();
+    if (!(le > 0.0) || !(l0 > 0.0) || !(l1 > 0.0)) return f;
+    const Vec3 eh = e / le;
+    Vec3 nb = n0 / l0 + n1 / l1;
+    if (!(nb.norm() > 1e-6)) nb = n0 / l0;
+    nb = (nb - eh * eh.dot(nb)).normalized(); // exactly ⟂ ê
+    f.col(0) = eh;
+    f.col(1) = nb;
+    f.col(2) = eh.cross(nb);
+    return f;
+}
+
+void setHingeRestShape(const Vec3 x[4], HingeRest& out) {
+    out.bent.setZero();
+    if (!(out.scale > 0.0)) return;
+    Vec3 s = Vec3::Zero();
+    for (int a = 0; a < 4; ++a) s += out.k[a] * x[a];
+    out.bent = hingeFrame(x).transpose() * s;
+    // |s̄| = 2|e| sin(θ/2) for a fold θ: below 1e-9 rad the hinge is flat (rounding of a plane).
+    if (!out.bent.allFinite() || !(out.bent.norm() > 1e-9 * (x[1] - x[0]).norm())) out.bent.setZero();
+}
+
+Vec3 strandBendTarget(const Vec3& restD, const Vec3& restTangent, const Vec3& tangent) {
+    const double n = tangent.norm();
+    if (!(n > 0.0)) return restD;
+    return Eigen::Quaterniond::FromTwoVectors(restTangent, tangent / n) * restD;
+}
+
 std::array<double, 3> strandBendWeights(double lPrev, double lNext) {
     const double a = 1.0 / lPrev, c = 1.0 / lNext;
     return {a, -(a + c), c};

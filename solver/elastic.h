@@ -67,8 +67,23 @@ bool membraneFactors(const MembraneRest& rest, const Vec3 x[3], double kStretch,
 struct HingeRest {
     std::array<double, 4> k{}; // cotangent weights (dimensionless)
     double scale = 0.0;        // 3 / (A0 + A1) (1/m²); 0 for a degenerate hinge
+    // A curved rest shape: the rest value of s̄ = Σ k_i X_i in the hinge's frame (edge ê,
+    // bisector normal n̂_b = (n̂0 + n̂1)/|n̂0 + n̂1|, b̂ = ê × n̂_b), metres; all zero when flat.
+    Vec3 bent = Vec3::Zero();
 };
 bool makeHingeRest(const Vec3 x[4], HingeRest& out);
+
+// Non-flat rest shapes (rest_shape = "mesh"): the energy becomes E = ½ c |s − r(x)|² with
+// r(x) = the rest s̄ carried into the current hinge frame (frameOf below), a rotation of the rest
+// vector with the hinge as in projective dynamics' bending (Bouaziz, Martin, Liu, Kavan, Pauly,
+// "Projective Dynamics", SIGGRAPH 2014). r is zero for a flat rest hinge (the flat model
+// above), E = 0 at the rest shape, and r is frozen in the Jacobian, which stays the constant
+// PSD c k kᵀ ⊗ I₃ (its rotation is explicit; it is small per substep for bends near the rest).
+// Stores the rest s̄ of x (the rest corners) in out.bent; out.k must be set (makeHingeRest).
+void setHingeRestShape(const Vec3 x[4], HingeRest& out);
+// The hinge frame (ê, n̂_b, b̂) at corners x, as columns; n̂_b falls back to n̂0 when the two
+// normals nearly cancel (a hinge folded flat onto itself).
+Mat3 hingeFrame(const Vec3 x[4]);
 
 // ---- Hair: a chain of segments ----
 // Stretch: E = ½ (EA / L)(|e| − L)² per segment (EA in N). Gradient along ê; stiffness
@@ -84,5 +99,10 @@ void springForces(const Vec3& x0, const Vec3& x1, double restLength, double ea, 
 // the unit rest tangent), E = ½ (EI / L̄) |d|², L̄ = (L_{i−1} + L_i)/2, EI in N·m² (straight rest
 // shape). d = Σ c_j x_j with constant weights c, so Q = (EI/L̄) c cᵀ ⊗ I₃ is constant and PSD.
 std::array<double, 3> strandBendWeights(double lPrev, double lNext);
+// A curled rest strand: E = ½ (EI/L̄) |d − R d̄|², d̄ the rest d and R the smallest rotation
+// taking the rest direction of segment i−1 to its current one (R frozen in the Jacobian, as for
+// cloth hinges above). The strand carries no material frame (no twist), so a curl keeps its
+// curvature but may roll about the incoming segment.
+Vec3 strandBendTarget(const Vec3& restD, const Vec3& restTangent, const Vec3& tangent);
 
 } // namespace gale::solver

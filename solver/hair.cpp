@@ -1,4 +1,4 @@
-// Hair strands: springs (EA/L), straight-rest bending (EI/L̄ |Δt|²/2), Rayleigh damping and
+// Hair strands: springs (EA/L), bending (EI/L̄ |Δt − R Δt̄|²/2, straight or curled rest), Rayleigh damping and
 // cross-flow drag (Wilson et al. 2014 use the normal/tangential split for hair, as Houdini's
 // dragnormal/dragtangent and Maya's tangential drag do). The wind is sampled at the vertices;
 // a segment feels the mean of its ends and moves with the mean of their velocities, so its
@@ -104,6 +104,10 @@ Hair::Hair(std::string name, Strands strands, HairMaterial material)
             bd.v[2] = i + 1;
             bd.w = strandBendWeights(l0, l1);
             bd.invLength = 2.0 / (l0 + l1);
+            if (mMat.curledRest) {
+                for (int a = 0; a < 3; ++a) bd.restD += bd.w[a] * vec3At(x, bd.v[a]);
+                bd.restTangent = (vec3At(x, i) - vec3At(x, i - 1)) / l0;
+            }
             mBends.push_back(bd);
         }
     }
@@ -174,6 +178,8 @@ void Hair::addForces(const ForceInput& in, ForceOutput& out) {
                 d += b.w[a] * vec3At(in.x, b.v[a]);
                 dv += b.w[a] * vec3At(in.v, b.v[a]);
             }
+            if (mMat.curledRest)
+                d -= strandBendTarget(b.restD, b.restTangent, vec3At(in.x, b.v[1]) - vec3At(in.x, b.v[0]));
             out.elasticEnergy += 0.5 * c * d.squaredNorm();
             for (int a = 0; a < 3; ++a) {
                 f.segment<3>(3 * b.v[a]) -= c * b.w[a] * (d + beta * dv);

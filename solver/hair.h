@@ -42,6 +42,9 @@ struct HairMaterial {
     PaintedParam dragNormal;       // C_n
     PaintedParam dragTangent;      // C_t
     bool rootPinned = true;
+    // Bending rest shape: false — straight; true — the strand's own polyline (a curl; elastic.h
+    // strandBendTarget).
+    bool curledRest = false;
     HairMaterial() {
         dragNormal.value = fields::Param(1.2);
         dragTangent.value = fields::Param(0.05);
@@ -71,6 +74,8 @@ private:
         int v[3];
         std::array<double, 3> w;
         double invLength; // 1 / L̄
+        Vec3 restD = Vec3::Zero();            // d at the rest shape (zero: straight)
+        Vec3 restTangent = Vec3::UnitX();     // unit rest direction of segment i−1
     };
     Strands mStrands;
     HairMaterial mMat;

@@ -26,13 +26,14 @@ struct PaintedSpec {
 };
 
 // Pinned vertices: a list, a painted map (> 0.5 pins), a box, or any union of them, moved by
-// an optional keyframed translation.
+// an optional keyframed rotation about a pivot and a keyframed translation (body.h, PinSet).
 struct PinSpec {
     std::vector<int> vertices;
     std::string map;
     bool hasBox = false;
     double box[6] = {0, 0, 0, 0, 0, 0};
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}};
+    PinRotation rotate;
     int line = 0, col = 0;
 };
 
@@ -43,10 +44,20 @@ struct ClothSpec {
     int gridRes[2] = {16, 16};
     Vec3 gridOrigin = Vec3::Zero();
     std::string gridAxes = "xy"; // the plane of the grid: u along the first axis, v the second
+    // Bending rest angles: "mesh" (the loaded mesh's, or rest_mesh's) | "flat"; "" — the
+    // default: "mesh" for a loaded mesh, "flat" for a grid.
+    std::string restShape;
+    std::string restMeshPath; // resolved; optional rest (sewing) shape, same topology as mesh
+    int restLine = 0, restCol = 0; // where rest_mesh was written
     ClothMaterial material;
     PaintedSpec lift, drag;
     bool hasPins = false;
     PinSpec pins;
+    // attach = { mesh = "body.#.obj", box | vertices | map }: the selected vertices bound to the
+    // body's surface at its first frame (PinSet::attach).
+    bool hasAttach = false;
+    PinSpec attach;
+    std::string attachMesh; // resolved
     StepOptions step;
     std::string output = "obj"; // obj | ply
     int line = 0, col = 0;
@@ -63,6 +74,10 @@ struct HairSpec {
     Vec3 direction = -Vec3::UnitY();
     HairMaterial material;
     PaintedSpec dragNormal, dragTangent;
+    // attach = { mesh = "scalp.#.obj", box = [...] (optional) }: roots bound to the surface.
+    bool hasAttach = false;
+    PinSpec attach;
+    std::string attachMesh; // resolved
     StepOptions step;
     std::string output = "obj";
     int line = 0, col = 0;

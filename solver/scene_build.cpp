@@ -3,6 +3,8 @@
 // and the output geometry (OBJ text, PLY point sets) of a body's current shape.
 #include "solver/scene.h"
 
+#include "solver/mesh_sequence.h"
+
 #include "fields/expression_field.h"
 #include "lang/diagnostics.h"
 #include "runtime/program.h"
@@ -12,6 +14,8 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 
 namespace gale::solver {
 
@@ -33,26 +37,32 @@ fields::SceneError sceneError(const SimScene& scene, int line, int col, std::str
     return e;
 }
 
-Vec3 axisOf(char c) { return c == 'x' ? Vec3::UnitX() : c == 'y' ? Vec3::UnitY() : Vec3::UnitZ(); }
+Vec3 axisOf(char c) {
+    return c == 'x' ? Vec3::UnitX() : c == 'y' ? Vec3::UnitY() : Vec3::UnitZ();
+}
 
 // Evaluates a painted map: a vertex property, or an expression (file or inline) at the rest
 // positions with $u, $v per vertex. Empty `values` when the spec has no map.
 bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::string& what,
-                 const std::vector<double>& positions, const std::vector<double>& u, const std::vector<double>& v,
-                 const std::map<std::string, std::vector<double>>& attributes, std::vector<double>& values,
-                 std::vector<fields::SceneError>& errors, const std::vector<std::string>& allowPaths) {
+                 const std::vector<double>& positions, const std::vector<double>& u,
+                 const std::vector<double>& v,
+                 const std::map<std::string, std::vector<double>>& attributes,
+                 std::vector<double>& values, std::vector<fields::SceneError>& errors,
+                 const std::vector<std::string>& allowPaths) {
     values.clear();
     const size_t n = positions.size() / 3;
     if (!spec.map.empty()) {
         auto it = attributes.find(spec.map);
         if (it == attributes.end()) {
-            fields::SceneError e = sceneError(scene, spec.line, spec.col,
-                                              what + ": the geometry has no vertex property '" + spec.map + "'");
+            fields::SceneError e =
+                sceneError(scene, spec.line, spec.col,
+                           what + ": the geometry has no vertex property '" + spec.map + "'");
             std::string names;
             for (const auto& a : attributes) names += (names.empty() ? "" : ", ") + a.first;
-            e.notes.push_back(names.empty() ? "it has no extra vertex properties (a generated grid has none: "
-                                              "paint with expr = \"file.se\" or source = \"...\")"
-                                            : "its vertex properties: " + names);
+            e.notes.push_back(names.empty()
+                                  ? "it has no extra vertex properties (a generated grid has none: "
+                                    "paint with expr = \"file.se\" or source = \"...\")"
+                                  : "its vertex properties: " + names);
             errors.push_back(std::move(e));
             return false;
         }
@@ -64,12 +74,14 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     if (!spec.exprPath.empty()) {
         std::ifstream in(spec.exprPath, std::ios::binary);
         if (!in) {
-            fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": cannot read '" + spec.exprPath + "'");
+            fields::SceneError e = sceneError(scene, spec.line, spec.col,
+                                              what + ": cannot read '" + spec.exprPath + "'");
             e.io = true;
             errors.push_back(std::move(e));
             return false;
         }
-        source = lang::SourceFile(spec.exprPath, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        source = lang::SourceFile(spec.exprPath, std::string((std::istreambuf_iterator<char>(in)),
+                                                             std::istreambuf_iterator<char>()));
     } else {
         source = lang::SourceFile(scene.wind.path + " (" + what + ")", spec.source);
     }
@@ -85,9 +97,11 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     files.rootDir = scene.wind.baseDir.empty() ? "." : scene.wind.baseDir;
     settings.functions = fields::fieldFunctions(files);
     lang::DiagnosticSink sink;
-    std::shared_ptr<const runtime::Program> program = runtime::Program::compile(source, settings, sink);
+    std::shared_ptr<const runtime::Program> program =
+        runtime::Program::compile(source, settings, sink);
     if (!program) {
-        fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": the map expression has errors");
+        fields::SceneError e =
+            sceneError(scene, spec.line, spec.col, what + ": the map expression has errors");
         std::string rendered = lang::renderDiagnostics(source, sink);
         while (!rendered.empty() && rendered.back() == '\n') rendered.pop_back();
         e.notes.push_back(rendered);
@@ -97,14 +111,16 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     runtime::EvalRequest req;
     req.count = n;
     req.uniforms = {{"t", {0.0}, ""}, {"frame", {0.0}, ""}, {"fps", {scene.wind.settings.fps}, ""}};
-    req.varyings = {{"P", 3, positions.data(), 3, 1}, {"u", 1, u.data(), 1, 1}, {"v", 1, v.data(), 1, 1}};
+    req.varyings = {
+        {"P", 3, positions.data(), 3, 1}, {"u", 1, u.data(), 1, 1}, {"v", 1, v.data(), 1, 1}};
     values.assign(n, 0.0);
     runtime::EvalOutput<double> out;
     out.data = values.data();
     out.pointStride = 1;
     const runtime::EvalResult r = runtime::evaluate<double>(*program, req, out);
     if (!r.ok) {
-        errors.push_back(sceneError(scene, spec.line, spec.col, what + ": the map expression could not run: " + r.error));
+        errors.push_back(sceneError(scene, spec.line, spec.col,
+                                    what + ": the map expression could not run: " + r.error));
         return false;
     }
     size_t bad = 0;
@@ -115,11 +131,68 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
         }
     if (bad) {
         errors.push_back(sceneError(scene, spec.line, spec.col,
-                                    what + ": the map is negative or not finite at " + std::to_string(bad) +
+                                    what + ": the map is negative or not finite at " +
+                                        std::to_string(bad) +
                                         " vertices (coefficients must be ≥ 0)"));
         return false;
     }
     return true;
+}
+
+// The vertices a pins or attach table selects: indices, a painted map (> 0.5), a box (union).
+bool selectVertices(const SimScene& scene, const PinSpec& spec, const std::string& what,
+                    const std::vector<double>& positions,
+                    const std::map<std::string, std::vector<double>>& attributes,
+                    std::vector<int>& out, std::vector<fields::SceneError>& errors) {
+    bool ok = true;
+    const size_t n = positions.size() / 3;
+    for (int idx : spec.vertices) {
+        if (idx < 0 || static_cast<size_t>(idx) >= n) {
+            errors.push_back(sceneError(scene, spec.line, spec.col,
+                                        what + ": vertex " + std::to_string(idx) +
+                                            " is out of range (the mesh has " + std::to_string(n) +
+                                            " vertices)"));
+            ok = false;
+            continue;
+        }
+        out.push_back(idx);
+    }
+    if (!spec.map.empty()) {
+        auto it = attributes.find(spec.map);
+        if (it == attributes.end()) {
+            errors.push_back(
+                sceneError(scene, spec.line, spec.col,
+                           what + ": the mesh has no vertex property '" + spec.map + "'"));
+            ok = false;
+        } else {
+            for (size_t i = 0; i < n; ++i)
+                if (it->second[i] > 0.5) out.push_back(static_cast<int>(i));
+        }
+    }
+    if (spec.hasBox) {
+        const double* b = spec.box;
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3 p = vec3At(positions.data(), i);
+            if (p.x() >= std::min(b[0], b[3]) && p.x() <= std::max(b[0], b[3]) &&
+                p.y() >= std::min(b[1], b[4]) && p.y() <= std::max(b[1], b[4]) &&
+                p.z() >= std::min(b[2], b[5]) && p.z() <= std::max(b[2], b[5]))
+                out.push_back(static_cast<int>(i));
+        }
+    }
+    return ok;
+}
+
+// Sequences named by several keys (a collider and an attachment) are read once per build.
+std::shared_ptr<const MeshSequence> loadSequence(const std::string& path, double fps,
+                                                 std::string& error) {
+    static std::map<std::pair<std::string, double>, std::weak_ptr<const MeshSequence>> cache;
+    static std::mutex lock;
+    std::lock_guard<std::mutex> g(lock);
+    auto& slot = cache[{path, fps}];
+    if (auto s = slot.lock()) return s;
+    std::shared_ptr<const MeshSequence> s = MeshSequence::load(path, fps, error);
+    slot = s;
+    return s;
 }
 
 } // namespace
@@ -140,7 +213,8 @@ WorldSettings worldSettings(const SimScene& scene, int threads) {
 // across the flow against the air (the symmetric part of its Jacobian has the negative
 // eigenvalue ½ρA (C_D − C_L)(v·n), docs/solver.md), a drift the model itself amplifies. A
 // warning at the lift key's file:line:col; painted maps scale both and are not looked at.
-std::string liftAboveDragWarning(const SimScene& scene, const ClothSpec& spec, const std::string& what) {
+std::string liftAboveDragWarning(const SimScene& scene, const ClothSpec& spec,
+                                 const std::string& what) {
     std::vector<double> times = {0.0};
     for (const fields::Param* p : {&spec.lift.value, &spec.drag.value})
         if (p->isKeyed()) times.insert(times.end(), p->times().begin(), p->times().end());
@@ -150,11 +224,13 @@ std::string liftAboveDragWarning(const SimScene& scene, const ClothSpec& spec, c
         const int line = spec.lift.line > 0 ? spec.lift.line : spec.line;
         const int col = spec.lift.line > 0 ? spec.lift.col : spec.col;
         char buf[160];
-        std::snprintf(buf, sizeof buf, "%s:%d:%d: %s: lift C_L = %.3g exceeds drag C_D = %.3g (at t = %.3g s)",
+        std::snprintf(buf, sizeof buf,
+                      "%s:%d:%d: %s: lift C_L = %.3g exceeds drag C_D = %.3g (at t = %.3g s)",
                       scene.wind.path.c_str(), line, col, what.c_str(), cl, cd, t);
         return std::string(buf) +
                ": the lift then pushes the cloth sideways against the air, an unstable drift the "
-               "solver keeps bounded but does not damp (docs/solver.md); keep lift at or below drag "
+               "solver keeps bounded but does not damp (docs/solver.md); keep lift at or below "
+               "drag "
                "for calm cloth";
     }
     return {};
@@ -170,7 +246,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         std::vector<double> u, v;
         if (spec.meshPath.empty()) {
             const Vec3 au = axisOf(spec.gridAxes[0]), av = axisOf(spec.gridAxes[1]);
-            mesh = makeGrid(spec.gridSize[0], spec.gridSize[1], spec.gridRes[0], spec.gridRes[1], spec.gridOrigin, au, av);
+            mesh = makeGrid(spec.gridSize[0], spec.gridSize[1], spec.gridRes[0], spec.gridRes[1],
+                            spec.gridOrigin, au, av);
             for (size_t i = 0; i < mesh.vertexCount(); ++i) {
                 u.push_back(mesh.uv[2 * i] / spec.gridSize[0]);
                 v.push_back(mesh.uv[2 * i + 1] / spec.gridSize[1]);
@@ -180,68 +257,100 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             int dropped = 0;
             if (!loadMesh(spec.meshPath, mesh, error, &dropped)) {
                 fields::SceneError e = sceneError(scene, spec.line, spec.col, what + ": " + error);
-                e.io = error.find("cannot open") != std::string::npos || error.find("No such file") != std::string::npos;
+                e.io = error.find("cannot open") != std::string::npos ||
+                       error.find("No such file") != std::string::npos;
                 errors.push_back(std::move(e));
                 continue;
             }
-            if (dropped) warnings.push_back(what + ": " + std::to_string(dropped) + " face(s) with bad indices were dropped");
+            if (dropped)
+                warnings.push_back(what + ": " + std::to_string(dropped) +
+                                   " face(s) with bad indices were dropped");
             const bool hasUv = mesh.uv.size() == 2 * mesh.vertexCount();
             for (size_t i = 0; i < mesh.vertexCount(); ++i) {
                 u.push_back(hasUv ? mesh.uv[2 * i] : 0.0);
                 v.push_back(hasUv ? mesh.uv[2 * i + 1] : 0.0);
             }
         }
+        // rest_mesh: rest lengths, areas and angles from it; the simulation starts from `mesh`.
+        TriMesh restMesh;
+        const bool hasRest = !spec.restMeshPath.empty();
+        if (hasRest) {
+            std::string error;
+            const std::string where = what + " rest_mesh '" + spec.restMeshPath + "'";
+            if (!loadMesh(spec.restMeshPath, restMesh, error)) {
+                fields::SceneError e =
+                    sceneError(scene, spec.restLine, spec.restCol, where + ": " + error);
+                e.io = true;
+                errors.push_back(std::move(e));
+                continue;
+            }
+            if (restMesh.vertexCount() != mesh.vertexCount() ||
+                restMesh.triangles != mesh.triangles) {
+                errors.push_back(
+                    sceneError(scene, spec.restLine, spec.restCol,
+                               where + " does not have the topology of '" + spec.meshPath + "' (" +
+                                   std::to_string(restMesh.vertexCount()) + " vertices and " +
+                                   std::to_string(restMesh.triangles.size()) +
+                                   " triangles against " + std::to_string(mesh.vertexCount()) +
+                                   " and " + std::to_string(mesh.triangles.size()) +
+                                   ", or the faces differ): a rest mesh must be the same mesh in "
+                                   "another pose"));
+                continue;
+            }
+            TriMesh r = mesh; // uv, attributes and faces of the simulated mesh, rest positions
+            r.positions = restMesh.positions;
+            restMesh = std::move(r);
+        }
+        const TriMesh& rest = hasRest ? restMesh : mesh;
         ClothMaterial mat = spec.material;
+        mat.curvedRest = spec.restShape.empty() ? !spec.meshPath.empty() : spec.restShape == "mesh";
         mat.lift.value = spec.lift.value;
         mat.drag.value = spec.drag.value;
-        bool ok = evaluateMap(scene, spec.lift, what + " lift", mesh.positions, u, v, mesh.attributes, mat.lift.map, errors, allowPaths);
-        ok = evaluateMap(scene, spec.drag, what + " drag", mesh.positions, u, v, mesh.attributes, mat.drag.map, errors, allowPaths) && ok;
+        bool ok = evaluateMap(scene, spec.lift, what + " lift", rest.positions, u, v,
+                              mesh.attributes, mat.lift.map, errors, allowPaths);
+        ok = evaluateMap(scene, spec.drag, what + " drag", rest.positions, u, v, mesh.attributes,
+                         mat.drag.map, errors, allowPaths) &&
+             ok;
         if (!ok) continue;
-        auto cloth = std::make_unique<Cloth>(spec.name, mesh, mat);
+        VecX start;
+        if (hasRest)
+            start = Eigen::Map<const VecX>(mesh.positions.data(),
+                                           static_cast<long>(mesh.positions.size()));
+        auto cloth = std::make_unique<Cloth>(spec.name, rest, mat, hasRest ? &start : nullptr);
         cloth->options() = spec.step;
         cloth->limits().overStretch = scene.solver.overStretch;
         cloth->limits().velocityJump = scene.solver.velocityJump;
         if (cloth->degenerateTriangles())
             warnings.push_back(what + ": " + std::to_string(cloth->degenerateTriangles()) +
                                " degenerate triangle(s) take no stretch force");
-        if (std::string w = liftAboveDragWarning(scene, spec, what); !w.empty()) warnings.push_back(w);
+        if (std::string w = liftAboveDragWarning(scene, spec, what); !w.empty())
+            warnings.push_back(w);
         if (spec.hasPins) {
             PinSet pins;
             pins.translate = spec.pins.translate;
-            const size_t n = mesh.vertexCount();
-            for (int idx : spec.pins.vertices) {
-                if (idx < 0 || static_cast<size_t>(idx) >= n) {
-                    errors.push_back(sceneError(scene, spec.pins.line, spec.pins.col,
-                                                what + " pins: vertex " + std::to_string(idx) + " is out of range (the mesh has " +
-                                                    std::to_string(n) + " vertices)"));
-                    ok = false;
-                    continue;
-                }
-                pins.vertices.push_back(idx);
-            }
-            if (!spec.pins.map.empty()) {
-                auto it = mesh.attributes.find(spec.pins.map);
-                if (it == mesh.attributes.end()) {
-                    errors.push_back(sceneError(scene, spec.pins.line, spec.pins.col,
-                                                what + " pins: the mesh has no vertex property '" + spec.pins.map + "'"));
-                    ok = false;
-                } else {
-                    for (size_t i = 0; i < n; ++i)
-                        if (it->second[i] > 0.5) pins.vertices.push_back(static_cast<int>(i));
-                }
-            }
-            if (spec.pins.hasBox) {
-                const double* b = spec.pins.box;
-                for (size_t i = 0; i < n; ++i) {
-                    const Vec3 p = mesh.position(i);
-                    if (p.x() >= std::min(b[0], b[3]) && p.x() <= std::max(b[0], b[3]) && p.y() >= std::min(b[1], b[4]) &&
-                        p.y() <= std::max(b[1], b[4]) && p.z() >= std::min(b[2], b[5]) && p.z() <= std::max(b[2], b[5]))
-                        pins.vertices.push_back(static_cast<int>(i));
-                }
-            }
+            pins.rotate = spec.pins.rotate;
+            ok = selectVertices(scene, spec.pins, what + " pins", mesh.positions, mesh.attributes,
+                                pins.vertices, errors) &&
+                 ok;
             if (ok && pins.vertices.empty())
                 warnings.push_back(what + ": the pins select no vertex");
             cloth->addPins(pins);
+        }
+        if (spec.hasAttach) {
+            PinSet att;
+            std::string problem;
+            att.attach = loadSequence(spec.attachMesh, scene.wind.settings.fps, problem);
+            if (!att.attach) {
+                errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
+                                            what + " attach: " + problem));
+                ok = false;
+            }
+            ok = selectVertices(scene, spec.attach, what + " attach", mesh.positions,
+                                mesh.attributes, att.vertices, errors) &&
+                 ok;
+            if (ok && att.vertices.empty())
+                warnings.push_back(what + ": the attachment selects no vertex");
+            if (ok) cloth->addPins(att);
         }
         if (ok) bodies.push_back(std::move(cloth));
     }
@@ -254,8 +363,9 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             if (a.norm() < 1e-6) a = d.cross(Vec3::UnitX());
             a.normalize();
             const Vec3 b = d.cross(a).normalized();
-            strands = makeStrandGrid(spec.origin, spec.gridSize[0], spec.gridSize[1], spec.gridCount[0], spec.gridCount[1],
-                                     spec.length, spec.segments, a, b, d);
+            strands =
+                makeStrandGrid(spec.origin, spec.gridSize[0], spec.gridSize[1], spec.gridCount[0],
+                               spec.gridCount[1], spec.length, spec.segments, a, b, d);
         } else {
             std::string error;
             if (!loadStrands(spec.strandsPath, strands, error)) {
@@ -271,23 +381,61 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             double total = 0.0;
             std::vector<double> acc(e - b, 0.0);
             for (int i = b + 1; i < e; ++i) {
-                total += (vec3At(strands.positions.data(), i) - vec3At(strands.positions.data(), i - 1)).norm();
+                total +=
+                    (vec3At(strands.positions.data(), i) - vec3At(strands.positions.data(), i - 1))
+                        .norm();
                 acc[i - b] = total;
             }
             for (int i = b; i < e; ++i) {
                 u[i] = total > 0 ? acc[i - b] / total : 0.0;
-                v[i] = strands.strandCount() > 1 ? static_cast<double>(s) / (strands.strandCount() - 1) : 0.0;
+                v[i] = strands.strandCount() > 1
+                           ? static_cast<double>(s) / (strands.strandCount() - 1)
+                           : 0.0;
             }
         }
         HairMaterial mat = spec.material;
         mat.dragNormal.value = spec.dragNormal.value;
         mat.dragTangent.value = spec.dragTangent.value;
-        bool ok = evaluateMap(scene, spec.dragNormal, what + " drag_normal", strands.positions, u, v, strands.attributes,
-                              mat.dragNormal.map, errors, allowPaths);
-        ok = evaluateMap(scene, spec.dragTangent, what + " drag_tangent", strands.positions, u, v, strands.attributes,
-                         mat.dragTangent.map, errors, allowPaths) && ok;
+        bool ok = evaluateMap(scene, spec.dragNormal, what + " drag_normal", strands.positions, u,
+                              v, strands.attributes, mat.dragNormal.map, errors, allowPaths);
+        ok = evaluateMap(scene, spec.dragTangent, what + " drag_tangent", strands.positions, u, v,
+                         strands.attributes, mat.dragTangent.map, errors, allowPaths) &&
+             ok;
         if (!ok) continue;
+        // attach: the selected roots (all without a selection) bound to the surface; the other
+        // roots stay pinned where they are when root_pinned.
+        PinSet att;
+        std::vector<int> otherRoots;
+        if (spec.hasAttach) {
+            std::string problem;
+            att.attach = loadSequence(spec.attachMesh, scene.wind.settings.fps, problem);
+            if (!att.attach) {
+                errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
+                                            what + " attach: " + problem));
+                continue;
+            }
+            std::vector<int> chosen;
+            const bool all =
+                spec.attach.vertices.empty() && spec.attach.map.empty() && !spec.attach.hasBox;
+            if (!all && !selectVertices(scene, spec.attach, what + " attach", strands.positions,
+                                        strands.attributes, chosen, errors))
+                continue;
+            std::vector<uint8_t> isChosen(n, all ? 1 : 0);
+            for (int c : chosen) isChosen[c] = 1;
+            for (size_t s = 0; s < strands.strandCount(); ++s)
+                (isChosen[strands.offsets[s]] ? att.vertices : otherRoots)
+                    .push_back(strands.offsets[s]);
+            if (att.vertices.empty()) warnings.push_back(what + ": the attachment selects no root");
+            if (!mat.rootPinned) otherRoots.clear();
+            mat.rootPinned = false;
+        }
         auto hair = std::make_unique<Hair>(spec.name, strands, mat);
+        if (spec.hasAttach) {
+            hair->addPins(att);
+            PinSet rest;
+            rest.vertices = otherRoots;
+            if (!rest.vertices.empty()) hair->addPins(rest);
+        }
         hair->options() = spec.step;
         hair->limits().overStretch = scene.solver.overStretch;
         hair->limits().velocityJump = scene.solver.velocityJump;
@@ -303,7 +451,9 @@ std::string bodyObjText(const Body& body) {
     out.reserve(body.vertexCount() * 40);
     out += "# gale " + std::string(body.kind()) + " '" + body.name() + "'\n";
     char buf[128];
-    auto put = [&](char* p, double v) { return std::to_chars(p, buf + sizeof buf, v, std::chars_format::general, 9).ptr; };
+    auto put = [&](char* p, double v) {
+        return std::to_chars(p, buf + sizeof buf, v, std::chars_format::general, 9).ptr;
+    };
     auto putInt = [&](char* p, long v) { return std::to_chars(p, buf + sizeof buf, v).ptr; };
     const VecX& x = body.positions();
     for (size_t i = 0; i < body.vertexCount(); ++i) {
@@ -331,7 +481,8 @@ std::string bodyObjText(const Body& body) {
         const Strands& s = h->strands();
         for (size_t k = 0; k < s.strandCount(); ++k) {
             out += "l";
-            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i) out += " " + std::to_string(i + 1);
+            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i)
+                out += " " + std::to_string(i + 1);
             out += "\n";
         }
     }
@@ -356,7 +507,8 @@ io::PointSet bodyPointSet(const Body& body) {
         std::vector<double> strand(body.vertexCount(), 0.0);
         const Strands& s = h->strands();
         for (size_t k = 0; k < s.strandCount(); ++k)
-            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i) strand[i] = static_cast<double>(k);
+            for (int i = s.offsets[k]; i < s.offsets[k + 1]; ++i)
+                strand[i] = static_cast<double>(k);
         ps.names.push_back("strand");
         ps.columns.push_back(std::move(strand));
     }

@@ -1,6 +1,8 @@
 # Writes N randomised hard scenes for tests/cli/hard_scenes.sh: wind 0-60 m/s (windicator keys,
-# gusts, presets, expressions), cloth densities 0.001-1 kg/m^2, hair, keyframed pins and
-# colliders; short and small. Deterministic: its own Park-Miller generator from `seed`.
+# gusts, presets, expressions), cloth densities 0.001-1 kg/m^2, hair, keyframed and rotating
+# pins, colliders, moving mesh bodies (OBJ sequences written beside the scene: boxes and thin
+# paddles flying up to 8 m/s and spinning up to 360 deg/s) and cloth or hair attached to them;
+# short and small. Deterministic: its own Park-Miller generator from `seed`.
 # Usage: awk -v seed=1 -v count=50 -v out=DIR -f hard_scenes.awk
 function rnd() { state = (state * 16807) % 2147483647; return state / 2147483647 }
 function uni(a, b) { return a + (b - a) * rnd() }
@@ -51,6 +53,21 @@ function field(f, i, dur, windicator,    kind, a, speed) {
             num(uni(0, 30)), num(uni(0, 60)) > f
     }
 }
+# A box of half sizes (hx, hy, hz) flying from `c0` at velocity `v` (m/s) and spinning about
+# y at `w` (rad/s), written as frames 1..n of OUT/NAME.####.obj (frame F at t = F/24).
+function body_sequence(name, n, hx, hy, hz, c0x, c0y, c0z, vx, vy, vz, w,    fr, t, k, x, y, z, c, sn, g, fn) {
+    for (fr = 1; fr <= n; fr++) {
+        t = (fr - 1) / 24
+        c = cos(w * t); sn = sin(w * t)
+        fn = sprintf("%s/%s.%04d.obj", out, name, fr)
+        for (k = 0; k < 8; k++) {
+            x = (k % 2) ? hx : -hx; y = (int(k / 2) % 2) ? hy : -hy; z = (int(k / 4) % 2) ? hz : -hz
+            printf "v %.6f %.6f %.6f\n", c * x + sn * z + c0x + vx * t, y + c0y + vy * t, -sn * x + c * z + c0z + vz * t > fn
+        }
+        printf "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n" > fn
+        close(fn)
+    }
+}
 BEGIN {
     if (count == "") count = 50
     if (out == "") out = "."
@@ -77,6 +94,17 @@ BEGIN {
         nf = 1 + pick(2)
         for (i = 0; i < nf; i++) field(f, i, dur, windicator)
         body = pick(10) # 0-4 cloth, 5-7 hair, 8-9 both
+        # A moving mesh body (a box or a 1-2 cm paddle) in about a third of the scenes; cloth
+        # or hair attached to it in half of those.
+        moving = rnd() < 0.35
+        attach = moving && rnd() < 0.5
+        seq = sprintf("s%d_hard%02d_body", seed, s)
+        if (moving) {
+            if (rnd() < 0.5) { hx = uni(0.05, 0.4); hy = uni(0.05, 0.4); hz = uni(0.05, 0.4) }
+            else { hx = uni(0.1, 0.4); hy = uni(0.1, 0.4); hz = uni(0.005, 0.01) }
+            body_sequence(seq, frames + 1, hx, hy, hz, uni(-0.3, 0.8), uni(0.5, 1.5), uni(-0.6, -0.2),
+                uni(-8, 8) * 0.3, uni(-8, 8) * 0.3, uni(0, 8), uni(-6.3, 6.3))
+        }
         if (body <= 4 || body >= 8) {
             axes = "xy"; if (rnd() < 0.3) axes = "xz"
             printf "\n[[cloth]]\nname = \"c\"\ngrid = { size = [%s, %s], res = [%d, %d], origin = [0, 1, 0], axes = \"%s\" }\n",
@@ -90,8 +118,11 @@ BEGIN {
             fmt = "obj"; if (rnd() < 0.5) fmt = "ply"
             printf "lift = %s\ndrag = %s\naero_model = \"%s\"\naero_jacobian = \"%s\"\nlinear_solver = \"%s\"\noutput = \"%s\"\n",
                 param(0, 1.5, dur), param(0, 2, dur), model, jac, lin, fmt > f
-            if (rnd() < 0.8) {
+            if (attach) {
+                printf "attach = { mesh = \"%s.#.obj\", box = [-10, 0.999, -10, 10, 1.001, 10] }\n", seq > f
+            } else if (rnd() < 0.8) {
                 move = ""; if (rnd() < 0.5) move = ", translate = " path("[0, 0, 0]", 1.5, dur)
+                if (rnd() < 0.3) move = move ", rotate = { pivot = " vec(-0.5, 0.5) ", axis = " vec(-1, 1) ", angle = " param(-360, 360, dur) " }"
                 printf "pins = { box = [-10, 0.999, -10, 10, 1.001, 10]%s }\n", move > f
             }
         }
@@ -105,7 +136,11 @@ BEGIN {
             printf "radius = %s\ndensity = %s\nstretch = %s\nbend = %s\ndrag_normal = %s\ndrag_tangent = %s\nroot_pinned = %s\noutput = \"%s\"\n",
                 num(logu(1e-5, 5e-4)), num(logu(100, 3000)), num(logu(10, 2000)), num(logu(1e-7, 1e-3)),
                 param(0, 2, dur), num(uni(0, 0.2)), pinned, fmt > f
+            if (attach) printf "attach = { mesh = \"%s.#.obj\" }\n", seq > f
         }
+        if (moving)
+            printf "\n[[collider]]\ntype = \"mesh\"\nmesh = \"%s.#.obj\"\nthickness = %s\nfriction = %s\n",
+                seq, num(logu(0.001, 0.02)), num(uni(0, 1)) > f
         nc = pick(3)
         for (c = 0; c < nc; c++) {
             kind = pick(3)

@@ -1,6 +1,7 @@
 # Numerical faults under load: 3 × 50 randomised hard scenes (hard_scenes.awk, three fixed seeds:
 # wind 0-60 m/s from windicator keys, gusts, presets and expressions; cloth of 0.001-1 kg/m^2 and
-# hair; keyframed pins, parameters and colliders) simulated two at a time. Every run exits 0 —
+# hair; keyframed and rotating pins, parameters and colliders; moving mesh bodies with cloth and
+# hair attached to them) simulated two at a time. Every run exits 0 —
 # trouble is recovered (halved substeps, at the smallest one strain limiting) and reported in
 # run.json, never a give-up (exit 4), a signal or another code — and no frame written holds a
 # NaN or an infinity. GALE_HARD_SEED=N runs one other set.
@@ -14,10 +15,14 @@ for SEED in $SEEDS; do
     awk -v seed="$SEED" -v count=50 -v out="scenes.$SEED" -f "$SRC/tests/cli/hard_scenes.awk" ||
         { fail "the scene generator"; finish; }
     for f in "scenes.$SEED"/*.toml; do mv "$f" "scenes/s${SEED}_${f##*/}"; done
+    for f in "scenes.$SEED"/*.obj; do [ -e "$f" ] && mv "$f" scenes/; done # moving bodies
     COUNT=$((COUNT + 50))
 done
 SEED="$SEEDS"
-expect_eq "$(ls scenes | wc -l)" "$COUNT" "generated scenes"
+expect_eq "$(ls scenes/*.toml | wc -l)" "$COUNT" "generated scenes"
+moving=$(grep -l 'type = "mesh"' scenes/*.toml | wc -l)
+attached=$(grep -l '^attach' scenes/*.toml | wc -l)
+[ "$moving" -gt 10 ] && [ "$attached" -gt 5 ] || fail "moving bodies in $moving scenes, attachments in $attached"
 
 # One run: exit code to NAME.rc, stderr to NAME.err (a signal shows as 128 + its number).
 cat > one.sh <<'SH'
@@ -71,5 +76,5 @@ for scene in scenes/*.toml; do
     done
     [ "$frames" -gt 0 ] || fail "$name: no frame written (exit $rc)"
 done
-echo "hard_scenes: seeds $SEED: $ok of $COUNT ran to the end (exit 0), $reported gave up (exit 4) in ${seconds}s on 2 workers" >&2
+echo "hard_scenes: seeds $SEED ($moving with moving bodies, $attached attached): $ok of $COUNT ran to the end (exit 0), $reported gave up (exit 4) in ${seconds}s on 2 workers" >&2
 finish

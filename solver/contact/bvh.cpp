@@ -1,0 +1,96 @@
+// The AABB tree: median splits (std::nth_element on the widest centre axis), leaves of up to
+// four primitives, nodes stored parents first so that a refit is one reverse sweep.
+#include "solver/contact/bvh.h"
+
+#include <algorithm>
+
+namespace gale::solver::contact {
+
+namespace {
+constexpr int kLeafSize = 4;
+}
+
+void Bvh::build(const std::vector<Box>& boxes) {
+    mNodes.clear();
+    mBoxes = boxes;
+    mOrder.resize(boxes.size());
+    for (size_t i = 0; i < boxes.size(); ++i) mOrder[i] = static_cast<int>(i);
+    std::vector<Eigen::Vector3d> centres(boxes.size());
+    for (size_t i = 0; i < boxes.size(); ++i) centres[i] = 0.5 * (boxes[i].lo + boxes[i].hi);
+    mNodes.reserve(2 * boxes.size() / kLeafSize + 2);
+    if (boxes.empty()) {
+        mNodes.emplace_back();
+        return;
+    }
+    buildRange(boxes, centres, 0, static_cast<int>(boxes.size()));
+}
+
+int Bvh::buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>& centres, int begin,
+                    int end) {
+    const int id = static_cast<int>(mNodes.size());
+    mNodes.emplace_back();
+    Box box, cbox;
+    for (int i = begin; i < end; ++i) {
+        box.add(boxes[mOrder[i]]);
+        cbox.add(centres[mOrder[i]]);
+    }
+    mNodes[id].box = box;
+    if (end - begin <= kLeafSize) {
+        mNodes[id].begin = begin;
+        mNodes[id].end = end;
+        return id;
+    }
+    int axis = 0;
+    const Eigen::Vector3d ext = cbox.hi - cbox.lo;
+    if (ext.y() > ext[axis]) axis = 1;
+    if (ext.z() > ext[axis]) axis = 2;
+    const int mid = begin + (end - begin) / 2;
+    std::nth_element(mOrder.begin() + begin, mOrder.begin() + mid, mOrder.begin() + end,
+                     [&](int a, int b) {
+                         return centres[a][axis] < centres[b][axis] ||
+                                (centres[a][axis] == centres[b][axis] && a < b);
+                     });
+    const int l = buildRange(boxes, centres, begin, mid);
+    const int r = buildRange(boxes, centres, mid, end);
+    mNodes[id].left = l;
+    mNodes[id].right = r;
+    return id;
+}
+
+void Bvh::refit(const std::vector<Box>& boxes) {
+    mBoxes = boxes;
+    for (size_t k = mNodes.size(); k-- > 0;) {
+        Node& n = mNodes[k];
+        Box b;
+        if (n.left < 0) {
+            for (int i = n.begin; i < n.end; ++i) b.add(boxes[mOrder[i]]);
+        } else {
+            b.add(mNodes[n.left].box);
+            b.add(mNodes[n.right].box);
+        }
+        n.box = b;
+    }
+}
+
+std::size_t Bvh::query(const Box& q, const std::function<void(int)>& fn) const {
+    if (mOrder.empty()) return 0;
+    std::size_t visited = 0;
+    int stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const Node& n = mNodes[stack[--top]];
+        ++visited;
+        if (!n.box.overlaps(q)) continue;
+        if (n.left < 0) {
+            for (int i = n.begin; i < n.end; ++i)
+                if (mBoxes[mOrder[i]].overlaps(q)) fn(mOrder[i]);
+        } else {
+            stack[top++] = n.left;
+            stack[top++] = n.right;
+        }
+    }
+    return visited;
+}
+
+} // namespace gale::solver::contact

@@ -1,0 +1,60 @@
+// A bounding volume hierarchy of axis-aligned boxes over a fixed set of primitives (triangles,
+// edges, vertices): built once top-down by median splits along the widest axis of the box
+// centres, then refitted bottom-up when the primitives move (the tree's topology kept, so a
+// refit costs one pass over the nodes), and queried with a box.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace gale::solver::contact {
+
+struct Box {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY),
+                    hi = Eigen::Vector3d::Constant(-INFINITY);
+    void add(const Eigen::Vector3d& p) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    void add(const Box& b) {
+        lo = lo.cwiseMin(b.lo);
+        hi = hi.cwiseMax(b.hi);
+    }
+    void inflate(double r) {
+        lo.array() -= r;
+        hi.array() += r;
+    }
+    bool overlaps(const Box& b) const {
+        return (lo.array() <= b.hi.array()).all() && (b.lo.array() <= hi.array()).all();
+    }
+};
+
+class Bvh {
+public:
+    // Builds the tree over `boxes` (one per primitive, index = primitive id).
+    void build(const std::vector<Box>& boxes);
+    // New boxes for the same primitives (same count): every node's box recomputed bottom-up.
+    void refit(const std::vector<Box>& boxes);
+    // Calls fn(primitive) for every primitive whose box overlaps `q`; returns the nodes visited.
+    std::size_t query(const Box& q, const std::function<void(int)>& fn) const;
+    std::size_t nodeCount() const { return mNodes.size(); }
+    std::size_t primitiveCount() const { return mOrder.size(); }
+    const Box& rootBox() const { return mNodes.front().box; }
+
+private:
+    struct Node {
+        Box box;
+        int left = -1, right = -1; // children (inner node), or -1
+        int begin = 0, end = 0;    // leaf: primitives mOrder[begin, end)
+    };
+    int buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>& centres, int begin,
+                   int end);
+    std::vector<Node> mNodes; // parents before children: a refit runs in reverse
+    std::vector<int> mOrder;
+    std::vector<Box> mBoxes; // per primitive, as last built or refitted
+};
+
+} // namespace gale::solver::contact

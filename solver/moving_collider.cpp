@@ -1,0 +1,310 @@
+// The moving-mesh contact: tree refits per step, closest points at the step's ends, and the
+// CCD pass. The response to a hit at time τ (the surface point q with weights w, the normal n
+// from the surface towards the cloth at τ):
+//   x₁ ← q(t₁) + ξ n₁   (n₁: the face normal at t₁ on the side of n; for an edge hit, the
+//                         cloth edge moved by the shortfall along n, split by its weights as in
+//                         Bridson, Fedkiw & Anderson 2002, §7.1),
+//   u = v₁ − v_s,  u ← u − min(0, u·n₁) n₁,  |u_t| ← max(0, |u_t| − μ |min(0, u·n₁)|),
+// v_s = Σ w_k (p_k(t₁) − p_k(t₀))/h the surface velocity: contact and friction in the moving
+// frame of the body. Each pass re-checks the moved trajectories x₀ → x₁; a vertex still hitting
+// after the last pass is left at its last projection (counted as unresolved).
+#include "solver/moving_collider.h"
+
+#include "solver/collider.h"
+#include "solver/contact/ccd.h"
+#include "solver/mesh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+namespace gale::solver {
+
+namespace {
+double seconds(std::chrono::steady_clock::time_point a) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
+}
+} // namespace
+
+MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
+    : mMesh(std::move(mesh)) {
+    mEdges = meshEdges(mMesh->triangles());
+    std::map<std::pair<int, int>, int> index;
+    for (size_t e = 0; e < mEdges.size(); ++e)
+        index[{mEdges[e][0], mEdges[e][1]}] = static_cast<int>(e);
+    mTriEdges.resize(mMesh->triangles().size());
+    for (size_t t = 0; t < mTriEdges.size(); ++t) {
+        const auto& tri = mMesh->triangles()[t];
+        for (int k = 0; k < 3; ++k) {
+            const int a = std::min(tri[k], tri[(k + 1) % 3]),
+                      b = std::max(tri[k], tri[(k + 1) % 3]);
+            mTriEdges[t][k] = index[{a, b}];
+        }
+    }
+}
+
+Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
+    return vec3At((atEnd ? mP1 : mP0).data(), v);
+}
+
+Vec3 MovingMeshContact::faceNormal(bool atEnd, int tri) const {
+    const auto& t = mMesh->triangles()[tri];
+    const Vec3 a = corner(atEnd, t[0]);
+    const Vec3 n = (corner(atEnd, t[1]) - a).cross(corner(atEnd, t[2]) - a);
+    const double l = n.norm();
+    return l > 0.0 ? Vec3(n / l) : Vec3::UnitY();
+}
+
+void MovingMeshContact::prepare(double t0, double t1, double margin) {
+    if (mBuilt && t0 == mT0 && t1 == mT1 && margin == mMargin) return;
+    const auto start = std::chrono::steady_clock::now();
+    if (!(mBuilt && t0 == mT1))
+        mMesh->positionsAt(t0, mP0);
+    else
+        mP0.swap(mP1); // consecutive steps: the last end is this start
+    mMesh->positionsAt(t1, mP1);
+    mT0 = t0;
+    mT1 = t1;
+    mMargin = margin;
+    const auto& tris = mMesh->triangles();
+    mBoxes.resize(tris.size());
+    for (size_t k = 0; k < tris.size(); ++k) {
+        contact::Box b;
+        for (int c = 0; c < 3; ++c) {
+            b.add(corner(false, tris[k][c]));
+            b.add(corner(true, tris[k][c]));
+        }
+        b.inflate(margin);
+        mBoxes[k] = b;
+    }
+    if (!mBuilt) {
+        mBvh.build(mBoxes);
+        mBuilt = true;
+    } else {
+        mBvh.refit(mBoxes);
+    }
+    ++mStats.refits;
+    mStats.refitSeconds += seconds(start);
+}
+
+bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const {
+    out.distance = INFINITY;
+    if (!mBuilt) return false;
+    contact::Box q;
+    q.add(x);
+    q.inflate(radius);
+    double best = radius * radius;
+    int bestTri = -1;
+    double bestW[3] = {0, 0, 0};
+    const auto& tris = mMesh->triangles();
+    mBvh.query(q, [&](int k) {
+        double w[3];
+        const double d2 = contact::pointTriangleDistance2(
+            x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]), corner(atEnd, tris[k][2]), w);
+        if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
+            best = d2;
+            bestTri = k;
+            std::copy(w, w + 3, bestW);
+        }
+    });
+    if (bestTri < 0) return false;
+    const auto& t = tris[bestTri];
+    Vec3 p = Vec3::Zero(), v = Vec3::Zero();
+    const double h = mT1 - mT0;
+    for (int c = 0; c < 3; ++c) {
+        p += bestW[c] * corner(atEnd, t[c]);
+        if (h > 0.0) v += bestW[c] * (corner(true, t[c]) - corner(false, t[c])) / h;
+    }
+    const Vec3 d = x - p;
+    const double dist = d.norm();
+    const Vec3 fn = faceNormal(atEnd, bestTri);
+    out.distance = dist;
+    out.normal = dist > 1e-12 ? Vec3(d / dist) : fn;
+    out.velocity = v;
+    return true;
+}
+
+int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
+                             const std::vector<uint8_t>& movable,
+                             const std::vector<std::array<int, 2>>& edges, double thickness,
+                             double friction, double h, int passes) {
+    if (!mBuilt) return 0;
+    const size_t n = x0.size() / 3;
+    const auto& tris = mMesh->triangles();
+    // The continuous pass keeps motions from coming closer than half the thickness (a crossing
+    // needs less); hits are placed at the full thickness, so that a re-check of the corrected
+    // motion has half the thickness to spare (no re-hit on resting contact), and the push-out
+    // after it (Body::resolveContacts) restores the full thickness everywhere else.
+    // Already within the thickness at the start (resting contact): only crossing is caught
+    // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
+    contact::CcdOptions opt;
+    opt.thickness = 0.5 * thickness;
+    opt.shrinkWithinThickness = true;
+    std::vector<int> cand;
+    std::vector<uint8_t> moved(n, 0);
+    int movedCount = 0;
+    // The velocity response at vertex i against a surface point moving at vs, normal n1.
+    auto respond = [&](int i, const Vec3& vs, const Vec3& n1) {
+        Eigen::Map<Vec3> v(v1.data() + 3 * i);
+        Vec3 u = v - vs;
+        const double un = u.dot(n1);
+        if (un < 0.0) {
+            u -= un * n1;
+            const Vec3 ut = u - n1 * u.dot(n1);
+            const double ts = ut.norm();
+            if (ts > 0.0) u -= std::min(1.0, friction * (-un) / ts) * ut;
+        }
+        v = vs + u;
+        if (!moved[i]) {
+            moved[i] = 1;
+            ++movedCount;
+        }
+    };
+    auto surfaceVelocity = [&](int tri, const double w[3]) {
+        Vec3 vs = Vec3::Zero();
+        if (h > 0.0)
+            for (int c = 0; c < 3; ++c)
+                vs += w[c] * (corner(true, tris[tri][c]) - corner(false, tris[tri][c])) / h;
+        return vs;
+    };
+    auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
+    for (int pass = 0; pass < passes; ++pass) {
+        int hits = 0;
+        // Vertices against triangles.
+        for (size_t i = 0; i < n; ++i) {
+            if (!movable[i]) continue;
+            const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
+            if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
+            auto tb = std::chrono::steady_clock::now();
+            contact::Box q;
+            q.add(p0);
+            q.add(p1);
+            q.inflate(thickness);
+            double first = 2.0;
+            int hitTri = -1;
+            cand.clear();
+            mBvh.query(q, [&](int k) { cand.push_back(k); });
+            mStats.broadSeconds += seconds(tb);
+            mStats.candidates += static_cast<long long>(cand.size());
+            auto tn = std::chrono::steady_clock::now();
+            for (int k : cand) {
+                const auto& t = tris[k];
+                double toi;
+                if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
+                                               corner(false, t[1]), corner(true, t[1]),
+                                               corner(false, t[2]), corner(true, t[2]), opt, toi) &&
+                    toi < first) {
+                    first = toi;
+                    hitTri = k;
+                }
+            }
+            if (hitTri >= 0) {
+                const auto& t = tris[hitTri];
+                double w[3];
+                const Vec3 a = lerp(corner(false, t[0]), corner(true, t[0]), first),
+                           b = lerp(corner(false, t[1]), corner(true, t[1]), first),
+                           c = lerp(corner(false, t[2]), corner(true, t[2]), first);
+                const Vec3 pt = lerp(p0, p1, first);
+                contact::pointTriangleDistance2(pt, a, b, c, w);
+                const Vec3 q0 = w[0] * a + w[1] * b + w[2] * c;
+                Vec3 nt = pt - q0;
+                const Vec3 fnt = (b - a).cross(c - a);
+                if (!(nt.norm() > 1e-12)) nt = fnt.dot(p0 - q0) >= 0.0 ? fnt : Vec3(-fnt);
+                const Vec3 fn1 = faceNormal(true, hitTri);
+                // The side the vertex is on, carried to the end of the step with the face.
+                Vec3 n1 = fn1.dot(nt) >= 0.0 ? fn1 : Vec3(-fn1);
+                // Off a face's interior use the direction to the closest point's feature instead
+                // (edges and corners: the normal of the face does not separate there).
+                const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
+                if (!interior) n1 = nt.normalized();
+                Vec3 q1 = Vec3::Zero();
+                for (int k = 0; k < 3; ++k) q1 += w[k] * corner(true, t[k]);
+                vec3At(x1.data(), i) = q1 + (thickness * (1.0 + 1e-6) + 1e-9) * n1;
+                respond(static_cast<int>(i), surfaceVelocity(hitTri, w), n1);
+                ++hits;
+                ++mStats.vertexHits;
+            }
+            mStats.narrowSeconds += seconds(tn);
+        }
+        // Cloth edges against body edges.
+        for (const auto& e : edges) {
+            const int i = e[0], j = e[1];
+            if (!movable[i] && !movable[j]) continue;
+            const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
+            const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
+            if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
+            auto tb = std::chrono::steady_clock::now();
+            contact::Box q;
+            q.add(a0);
+            q.add(a1);
+            q.add(b0);
+            q.add(b1);
+            q.inflate(thickness);
+            cand.clear();
+            mBvh.query(q, [&](int k) {
+                for (int c = 0; c < 3; ++c) cand.push_back(mTriEdges[k][c]);
+            });
+            std::sort(cand.begin(), cand.end());
+            cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+            mStats.broadSeconds += seconds(tb);
+            mStats.candidates += static_cast<long long>(cand.size());
+            auto tn = std::chrono::steady_clock::now();
+            double first = 2.0;
+            int hitEdge = -1;
+            for (int k : cand) {
+                const int r = mEdges[k][0], s = mEdges[k][1];
+                double toi;
+                if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
+                                         corner(false, s), corner(true, s), opt, toi) &&
+                    toi < first) {
+                    first = toi;
+                    hitEdge = k;
+                }
+            }
+            if (hitEdge >= 0) {
+                const int r = mEdges[hitEdge][0], s = mEdges[hitEdge][1];
+                double sa, sb;
+                const Vec3 pa = lerp(a0, a1, first), pb = lerp(b0, b1, first);
+                const Vec3 pr = lerp(corner(false, r), corner(true, r), first),
+                           ps = lerp(corner(false, s), corner(true, s), first);
+                contact::segmentSegmentDistance2(pa, pb, pr, ps, sa, sb);
+                Vec3 nt = (pa + sa * (pb - pa)) - (pr + sb * (ps - pr));
+                if (!(nt.norm() > 1e-12)) nt = (pb - pa).cross(ps - pr);
+                if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
+                const Vec3 nn = nt.normalized();
+                // At the end: the body point and the cloth point at the same parameters.
+                const Vec3 r1 = corner(true, r), s1 = corner(true, s);
+                const Vec3 body1 = r1 + sb * (s1 - r1);
+                Eigen::Map<Vec3> xa(x1.data() + 3 * i), xb(x1.data() + 3 * j);
+                const Vec3 cloth1 = xa + sa * (xb - xa);
+                const double gap = (cloth1 - body1).dot(nn);
+                const double want = thickness * (1.0 + 1e-6) + 1e-9;
+                if (gap < want) {
+                    // Move the cloth point by (want − gap) n: the edge's vertices by their
+                    // weights, scaled so the interpolated point moves exactly that far.
+                    const double wa = movable[i] ? 1.0 - sa : 0.0, wb = movable[j] ? sa : 0.0;
+                    const double norm = wa * (1.0 - sa) + wb * sa;
+                    if (norm > 1e-12) {
+                        const Vec3 d = ((want - gap) / norm) * nn;
+                        xa += wa * d;
+                        xb += wb * d;
+                    }
+                }
+                Vec3 vs = Vec3::Zero();
+                if (h > 0.0)
+                    vs = ((1.0 - sb) * (r1 - corner(false, r)) + sb * (s1 - corner(false, s))) / h;
+                if (movable[i]) respond(i, vs, nn);
+                if (movable[j]) respond(j, vs, nn);
+                ++hits;
+                ++mStats.edgeHits;
+            }
+            mStats.narrowSeconds += seconds(tn);
+        }
+        if (hits == 0) break;
+        if (pass == passes - 1) mStats.unresolved += hits;
+    }
+    return movedCount;
+}
+
+} // namespace gale::solver
