@@ -85,8 +85,8 @@ ArrowGrid sliceArrows(const Slice& slice, double plotW, double plotH, double spa
     return g;
 }
 
-bool sliceDirection(const Slice& s, double plotW, double plotH, double maxSpeed, double x,
-                    double y, double& dx, double& dy) {
+bool sliceDirection(const Slice& s, double plotW, double plotH, double maxSpeed, double x, double y,
+                    double& dx, double& dy) {
     if (x < 0 || y < 0 || x > plotW || y > plotH) return false;
     const double fx = std::clamp(x * s.nu / plotW - 0.5, 0.0, s.nu - 1.0);
     const double fy = std::clamp(y * s.nv / plotH - 0.5, 0.0, s.nv - 1.0);

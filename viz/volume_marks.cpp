@@ -18,7 +18,8 @@ bool inside(const Box3& box, const double* p) {
 
 // Samples `count` points; non-finite velocities come back as zero.
 fields::SampleStatus sampleAt(const fields::Field& field, const fields::SampleTime& when,
-                              const std::vector<double>& positions, std::vector<double>& velocities) {
+                              const std::vector<double>& positions,
+                              std::vector<double>& velocities) {
     const size_t count = positions.size() / 3;
     velocities.assign(3 * count, 0.0);
     fields::GridSampleOptions sampling;
@@ -49,8 +50,7 @@ fields::SampleStatus sampleArrowVolume(const fields::Field& field, const fields:
             for (int c = 0; c < n; ++c, ++i) {
                 const int idx[3] = {a, b, c};
                 for (int k = 0; k < 3; ++k)
-                    positions[3 * i + k] =
-                        box.lo[k] + (idx[k] + 0.5) / n * (box.hi[k] - box.lo[k]);
+                    positions[3 * i + k] = box.lo[k] + (idx[k] + 0.5) / n * (box.hi[k] - box.lo[k]);
             }
     status = sampleAt(field, when, positions, velocities);
     if (!status.ok) return status;
@@ -58,9 +58,10 @@ fields::SampleStatus sampleArrowVolume(const fields::Field& field, const fields:
     out.positions.assign(positions.begin(), positions.end());
     out.velocities.assign(velocities.begin(), velocities.end());
     for (size_t p = 0; p < count; ++p)
-        out.maxSpeed = std::max(out.maxSpeed, std::sqrt(velocities[3 * p] * velocities[3 * p] +
-                                                        velocities[3 * p + 1] * velocities[3 * p + 1] +
-                                                        velocities[3 * p + 2] * velocities[3 * p + 2]));
+        out.maxSpeed =
+            std::max(out.maxSpeed, std::sqrt(velocities[3 * p] * velocities[3 * p] +
+                                             velocities[3 * p + 1] * velocities[3 * p + 1] +
+                                             velocities[3 * p + 2] * velocities[3 * p + 2]));
     return status;
 }
 

@@ -39,8 +39,8 @@ struct Streamline {
 };
 
 struct StreamlineOptions {
-    double step = 0.05;  // arc length of one RK2 step (m)
-    int maxSteps = 64;   // per direction
+    double step = 0.05;     // arc length of one RK2 step (m)
+    int maxSteps = 64;      // per direction
     double minSpeed = 1e-6; // m/s: the line stops where the wind is slower
 };
 

@@ -9,8 +9,11 @@
 using namespace gale;
 
 TEST_CASE("arrow volume samples the field at every cell centre", "[viz][volume]") {
-    fields::FunctionField field([](const fields::Vec3& x, double) { return fields::Vec3{x[0], 2 * x[1], 0.0}; },
-                                "linear");
+    fields::FunctionField field(
+        [](const fields::Vec3& x, double) {
+            return fields::Vec3{x[0], 2 * x[1], 0.0};
+        },
+        "linear");
     viz::Box3 box;
     box.lo = {0, 0, 0};
     box.hi = {1, 2, 4};
@@ -48,7 +51,8 @@ TEST_CASE("streamlines run straight in a uniform wind and stop at the box", "[vi
         // dropped, so 12 points each way plus the seed.
         REQUIRE(l.points.size() == 25);
         for (size_t k = 1; k < l.points.size(); ++k) {
-            const double dx = l.points[k][0] - l.points[k - 1][0], dz = l.points[k][2] - l.points[k - 1][2];
+            const double dx = l.points[k][0] - l.points[k - 1][0],
+                         dz = l.points[k][2] - l.points[k - 1][2];
             CHECK(std::hypot(dx, dz) == Approx(0.1).epsilon(1e-5));
             CHECK(dx / dz == Approx(0.75).epsilon(1e-5)); // downstream: the same direction
             CHECK(dz > 0);
@@ -60,8 +64,11 @@ TEST_CASE("streamlines run straight in a uniform wind and stop at the box", "[vi
 }
 
 TEST_CASE("streamlines of a rigid rotation stay on their circles", "[viz][volume]") {
-    fields::FunctionField spin([](const fields::Vec3& x, double) { return fields::Vec3{-x[1], x[0], 0.0}; },
-                               "spin");
+    fields::FunctionField spin(
+        [](const fields::Vec3& x, double) {
+            return fields::Vec3{-x[1], x[0], 0.0};
+        },
+        "spin");
     viz::Box3 box;
     box.lo = {-2, -2, -1};
     box.hi = {2, 2, 1};
@@ -78,7 +85,8 @@ TEST_CASE("streamlines of a rigid rotation stay on their circles", "[viz][volume
     const double radius[3] = {0.5, 1.0, 1.5};
     for (int s = 0; s < 3; ++s) {
         // RK2's radial drift per step is O(h^3 / r^2); over 100 steps well under 0.1%.
-        for (const auto& p : lines[s].points) CHECK(std::hypot(p[0], p[1]) == Approx(radius[s]).epsilon(1e-3));
+        for (const auto& p : lines[s].points)
+            CHECK(std::hypot(p[0], p[1]) == Approx(radius[s]).epsilon(1e-3));
         CHECK(lines[s].speed.front() == Approx(radius[s]).epsilon(1e-3));
     }
     // Counter-clockwise downstream: 100 steps of 0.02 m on the unit circle end at +2 rad, and
