@@ -1,6 +1,8 @@
 // The live page's JSON documents (json.h), built with nlohmann::json.
 #include "live/json.h"
 
+#include "viz/plot_geometry.h"
+
 #include <cmath>
 
 namespace gale::live {
@@ -23,6 +25,16 @@ json rounded(const std::vector<T>& v) {
 
 json vec(const std::array<double, 3>& v) {
     return json::array({v[0], v[1], v[2]});
+}
+
+// viz::viridis at 33 even stops: the page interpolates between them.
+json colormap() {
+    json m = json::array();
+    for (int i = 0; i <= 32; ++i) {
+        const viz::Rgb c = viz::viridis(i / 32.0);
+        m.push_back({round4(c.r), round4(c.g), round4(c.b)});
+    }
+    return m;
 }
 
 json valueJson(const std::vector<double>& v) {
@@ -125,7 +137,8 @@ json fieldJson(const FieldFrame& f, const viz::SliceOverlays& o) {
                   {"plane", s.planeValue},
                   {"speed", rounded(f.speed.speed)},
                   {"max", f.speed.max},
-                  {"top", f.speed.top}};
+                  {"top", f.speed.top},
+                  {"colormap", colormap()}};
     json arrows = {{"n", f.arrows.n},
                    {"positions", rounded(f.arrows.positions)},
                    {"velocities", rounded(f.arrows.velocities)},

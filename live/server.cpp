@@ -272,8 +272,8 @@ private:
             {"panels.js", {web + "/panels.js", "text/javascript"}},
             {"view.js", {web + "/view.js", "text/javascript"}},
             {"style.css", {web + "/style.css", "text/css"}},
-            {"three.module.min.js", {mods + "/three/build/three.module.min.js", "text/javascript"}},
-            {"three.core.min.js", {mods + "/three/build/three.core.min.js", "text/javascript"}},
+            {"three.module.js", {mods + "/three/build/three.module.js", "text/javascript"}},
+            {"three.core.js", {mods + "/three/build/three.core.js", "text/javascript"}},
             {"OrbitControls.js",
              {mods + "/three/examples/jsm/controls/OrbitControls.js", "text/javascript"}},
         };
