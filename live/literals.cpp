@@ -119,7 +119,8 @@ std::string numberText(double v) {
 SourceLiterals findLiterals(const lang::SourceFile& source) {
     SourceLiterals out;
     const std::string& text = source.text();
-    for (const fields::ParameterDecl& d : fields::findParameters(source)) {
+    const std::vector<fields::ParameterDecl> decls = fields::findParameters(source);
+    for (const fields::ParameterDecl& d : decls) {
         ParamLiteral p;
         p.name = d.name;
         p.value = d.defaultValue;
@@ -141,15 +142,18 @@ SourceLiterals findLiterals(const lang::SourceFile& source) {
         p.integer = p.hasRange && whole(p.min) && whole(p.max) && allWhole;
         out.params.push_back(std::move(p));
     }
+    // Parsed as the compiler sees it: the declarations blanked (every other byte keeps its
+    // offset), so `def`s may follow them.
+    const lang::SourceFile parsed = fields::withoutParameters(source, decls);
     lang::DiagnosticSink sink;
-    std::unique_ptr<lang::Ast> ast = lang::parseProgram(source, sink);
+    std::unique_ptr<lang::Ast> ast = lang::parseProgram(parsed, sink);
     if (ast && !sink.hasErrors()) {
         for (const lang::FunctionDef* d : ast->defs) {
-            visit(d->body, source, out.ramps);
-            visit(d->result, source, out.ramps, 0);
+            visit(d->body, parsed, out.ramps);
+            visit(d->result, parsed, out.ramps, 0);
         }
-        visit(ast->statements, source, out.ramps);
-        visit(ast->result, source, out.ramps, 0);
+        visit(ast->statements, parsed, out.ramps);
+        visit(ast->result, parsed, out.ramps, 0);
     }
     return out;
 }
