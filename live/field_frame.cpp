@@ -75,7 +75,7 @@ bool computeFieldFrame(const fields::Field& field, double fps, const viz::Box3& 
         viz::StreamlineOptions opt;
         double size = 0.0;
         for (int c = 0; c < 3; ++c) size = std::max(size, box.hi[c] - box.lo[c]);
-        opt.step = size / 64.0;
+        opt.step = size / 40.0; // 64 steps each way: 1.6 box sizes
         opt.maxSteps = 64;
         const fields::SampleStatus l =
             viz::traceRake(field, when, r.rake, box, opt, out.streamlines);

@@ -57,6 +57,13 @@ bool hostAllowed(const std::string& host, const std::string& boundHost, int port
 
 namespace {
 
+// cpp-httplib compresses `application/json`, `application/javascript` and `text/*` replies with
+// brotli at its highest quality when the browser accepts it, which takes seconds for a
+// megabyte; on loopback it only costs time, so the JSON and the scripts are sent with a charset
+// parameter, which that check does not match (text/html and text/css are small).
+constexpr const char* kJson = "application/json; charset=utf-8";
+constexpr const char* kScript = "application/javascript; charset=utf-8";
+
 bool sameToken(const std::string& a, const std::string& b) {
     if (a.size() != b.size() || a.empty()) return false;
     unsigned char d = 0;
@@ -78,7 +85,7 @@ bool readFile(const std::string& path, std::string& out, size_t limit) {
 
 void fail(httplib::Response& res, int status, const std::string& message) {
     res.status = status;
-    res.set_content(errorJson(message), "application/json");
+    res.set_content(errorJson(message), kJson);
 }
 
 // A finite number query parameter; `def` when absent. False on a malformed value.
@@ -249,7 +256,7 @@ private:
                 res.set_content(errorJson(res.status == 404 ? "no such endpoint"
                                                             : "bad request (HTTP " +
                                                                   std::to_string(res.status) + ")"),
-                                "application/json");
+                                kJson);
         });
         mHttp.set_exception_handler(
             [](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
@@ -268,14 +275,14 @@ private:
         });
         // Only these files are served from disk besides the scene's own.
         const std::map<std::string, std::pair<std::string, const char*>> assets = {
-            {"app.js", {web + "/app.js", "text/javascript"}},
-            {"panels.js", {web + "/panels.js", "text/javascript"}},
-            {"view.js", {web + "/view.js", "text/javascript"}},
+            {"app.js", {web + "/app.js", kScript}},
+            {"panels.js", {web + "/panels.js", kScript}},
+            {"view.js", {web + "/view.js", kScript}},
             {"style.css", {web + "/style.css", "text/css"}},
-            {"three.module.js", {mods + "/three/build/three.module.js", "text/javascript"}},
-            {"three.core.js", {mods + "/three/build/three.core.js", "text/javascript"}},
+            {"three.module.js", {mods + "/three/build/three.module.js", kScript}},
+            {"three.core.js", {mods + "/three/build/three.core.js", kScript}},
             {"OrbitControls.js",
-             {mods + "/three/examples/jsm/controls/OrbitControls.js", "text/javascript"}},
+             {mods + "/three/examples/jsm/controls/OrbitControls.js", kScript}},
         };
         mHttp.Get(R"(/assets/([A-Za-z0-9_.-]+))",
                   [this, assets](const httplib::Request& req, httplib::Response& res) {
@@ -285,11 +292,11 @@ private:
                   });
         mHttp.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
-            res.set_content(stateJson(mProject, mTime).dump(), "application/json");
+            res.set_content(stateJson(mProject, mTime).dump(), kJson);
         });
         mHttp.Get("/api/scene", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
-            res.set_content(sceneJson(mProject).dump(), "application/json");
+            res.set_content(sceneJson(mProject).dump(), kJson);
         });
         mHttp.Get("/api/file", [this](const httplib::Request& req, httplib::Response& res) {
             const std::string path =
@@ -307,7 +314,7 @@ private:
             if (!readFile(path, text, 4u << 20)) return fail(res, 404, path + ": cannot read");
             res.set_content(json{{"path", path}, {"text", text}}.dump(
                                 -1, ' ', false, json::error_handler_t::replace),
-                            "application/json");
+                            kJson);
         });
         mHttp.Get("/api/field",
                   [this](const httplib::Request& req, httplib::Response& res) { field(req, res); });
@@ -393,7 +400,7 @@ private:
             overlays = mProject.overlays(r.time);
             mTime = r.time;
         }
-        res.set_content(fieldJson(frame, overlays).dump(), "application/json");
+        res.set_content(fieldJson(frame, overlays).dump(), kJson);
     }
 
     void frame(const httplib::Request& req, httplib::Response& res) {
@@ -411,7 +418,7 @@ private:
             g.label = o.name;
             objects.push_back(geometryJson(g));
         }
-        res.set_content(json{{"frame", n}, {"objects", objects}}.dump(), "application/json");
+        res.set_content(json{{"frame", n}, {"objects", objects}}.dump(), kJson);
     }
 
     bool bodyJson(const httplib::Request& req, httplib::Response& res, json& out) {
@@ -427,7 +434,7 @@ private:
     void replyState(httplib::Response& res) {
         std::lock_guard<std::mutex> lock(mMutex);
         mProject.load();
-        res.set_content(stateJson(mProject, mTime).dump(), "application/json");
+        res.set_content(stateJson(mProject, mTime).dump(), kJson);
     }
 
     void setParam(const httplib::Request& req, httplib::Response& res) {
@@ -536,7 +543,7 @@ private:
         res.set_content(
             json{{"running", mSim.running()}, {"dir", mSim.outDir()}, {"last", mSim.lastFrame()}}
                 .dump(),
-            "application/json");
+            kJson);
     }
 
     ServerOptions mOpt;

@@ -15,7 +15,7 @@ async function api(path, body) {
   return j;
 }
 
-const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false });
+const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null });
 const view = new View($('view'));
 const timeline = new Timeline($('timeline'), (t) => setTime(t));
 let state = null, scene = null, fieldData = null, currentFile = null;
@@ -38,7 +38,9 @@ async function refreshField() {
   if (inFlight) { queued = true; return; }
   inFlight = true;
   try {
+    const t0 = performance.now();
     fieldData = await api(sliceRequest());
+    const t1 = performance.now();
     const s = fieldData.slice, map = s.colormap;
     view.setSlice(s, map);
     view.setArrows(fieldData.arrows, map, s.top);
@@ -50,6 +52,7 @@ async function refreshField() {
     $('windicator').textContent = w.present ? `windicator ${fmt(w.speed, 2)} m/s → [${w.direction.map((c) => fmt(c, 2)).join(', ')}]` : '';
     timeline.set(fieldData.overlays.timeline, state.fps, state.frames);
     live.fieldUpdates++;
+    live.lastFieldMs = { fetch: t1 - t0, draw: performance.now() - t1 };
   } catch (e) {
     live.errors.push(String(e.message || e));
   } finally {
@@ -137,6 +140,7 @@ async function showSimFrame(f) {
   try {
     const fr = await api('/api/frame?n=' + n);
     view.setSimFrame(fr.objects);
+    live.simFrameShown = n;
   } catch (e) {
     live.errors.push(String(e.message || e));
   }
@@ -218,6 +222,7 @@ function wire() {
 }
 
 (async () => {
+  live.loadedAt = performance.now();
   try {
     wire();
     events();

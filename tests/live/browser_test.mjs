@@ -13,8 +13,9 @@ const { CHROME, URL: url, SCENE_DIR, SHOT } = process.env;
 const se = path.join(SCENE_DIR, 'ice_wind.se');
 const original = fs.readFileSync(se, 'utf8');
 let failures = 0;
+const started = Date.now();
 const check = (ok, what) => {
-  console.log((ok ? 'ok   ' : 'FAIL ') + what);
+  console.log((ok ? 'ok   ' : 'FAIL ') + what + `  [${((Date.now() - started) / 1000).toFixed(1)} s]`);
   if (!ok) failures++;
 };
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -72,7 +73,9 @@ try {
     }
     return { colours: colours.size, hash, w: c.width, h: c.height };
   });
+  console.log('     page timings (ms): ' + JSON.stringify(await page.evaluate(() => ({ modulesLoaded: window.galeLive.loadedAt, ...window.galeLive.lastFieldMs }))));
   const first = await pixels();
+  await page.screenshot({ path: SHOT });
   check(first.colours > 200, `the canvas is drawn: ${first.colours} distinct colours over ${first.w}x${first.h}`);
 
   // An edit on disk: the wind gains a vertical wave; the page redraws a different slice.
@@ -104,8 +107,19 @@ try {
     }
   }
   await until(() => page.evaluate((n0) => window.galeLive.stateUpdates > n0, n), 10000, 'the slider\'s edit comes back as state');
-  await sleep(300);
-  await page.screenshot({ path: SHOT });
+
+  // Simulate: a short run (frames 1-6) plays its frames in the page as they are written.
+  const toml = path.join(SCENE_DIR, 'scene.toml');
+  const scene = fs.readFileSync(toml, 'utf8');
+  n = await page.evaluate(() => window.galeLive.stateUpdates);
+  fs.writeFileSync(toml, scene.replace(/^frames = \[1, 72\]/m, 'frames = [1, 6]'));
+  await until(() => page.evaluate((n0) => window.galeLive.stateUpdates > n0, n), 10000, 'the scene edit reaches the page');
+  await page.click('#simulate');
+  const shown = await until(() => page.evaluate(() => window.galeLive.simFrameShown), 30000, 'a simulated frame is drawn');
+  check(shown >= 1 && shown <= 6, `simulated frame ${shown} is drawn in the page`);
+  await until(() => page.evaluate(() => /done: 6 frames/.test(document.getElementById('simText').textContent)), 30000,
+    'the simulation ends with 6 frames');
+  fs.writeFileSync(toml, scene);
 
   // A syntax error: the page shows file:line:col and gale check's message.
   fs.writeFileSync(se, original.replace('dir = norm(getVar("windDir", [1, 0, 0]));', 'dir = norm(getVar("windDir", [1, 0, 0]);'));

@@ -35,7 +35,7 @@ start_server() {
     SERVER_PID=$!
     URL=
     for _ in $(seq 200); do
-        URL=$(grep -o 'http://127.0.0.1:[0-9]*/?token=[0-9a-f]*' "$TMP/server.err" | head -1)
+        URL=$(grep -o 'http://127.0.0.1:[0-9]*/?token=[0-9a-f]*' "$TMP/server.err" 2>/dev/null | head -1)
         [ -n "$URL" ] && break
         kill -0 "$SERVER_PID" 2>/dev/null || break
         sleep 0.05
