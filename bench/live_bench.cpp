@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
         // the turbulence is synthesised anew (no cached tile fits).
         std::string edited = text;
         const std::string from = "$turbulenceScale = 0.5;";
-        edited.replace(edited.find(from), from.size(), "$turbulenceScale = " + std::to_string(0.5 + 0.01 * i) + ";");
+        edited.replace(edited.find(from), from.size(),
+                       "$turbulenceScale = " + std::to_string(0.5 + 0.01 * i) + ";");
         {
             std::lock_guard<std::mutex> lock(m);
             fired = false;
@@ -115,7 +116,8 @@ int main(int argc, char** argv) {
         if (!project.load()) return 1;
         const Clock::time_point t3 = Clock::now();
         live::FieldFrame frame;
-        if (!live::computeFieldFrame(*project.field(), project.fps(), project.box(), request, frame, error)) {
+        if (!live::computeFieldFrame(*project.field(), project.fps(), project.box(), request, frame,
+                                     error)) {
             std::fprintf(stderr, "%s\n", error.c_str());
             return 1;
         }
@@ -126,11 +128,13 @@ int main(int argc, char** argv) {
 
         // Baseline: the same number of points as the frame sampled, in one batch.
         points = frame.slice.velocity.size() / 3 + frame.arrows.positions.size() / 3;
-        for (const viz::Streamline& l : frame.streamlines) points += 2 * l.points.size(); // two RK2 stages
+        for (const viz::Streamline& l : frame.streamlines)
+            points += 2 * l.points.size(); // two RK2 stages
         std::vector<double> pos(3 * points), vel(3 * points);
         for (size_t k = 0; k < points; ++k)
             for (int c = 0; c < 3; ++c)
-                pos[3 * k + c] = box.lo[c] + (box.hi[c] - box.lo[c]) * ((k * (c + 7) * 2654435761u) % 1000) / 1000.0;
+                pos[3 * k + c] = box.lo[c] + (box.hi[c] - box.lo[c]) *
+                                                 ((k * (c + 7) * 2654435761u) % 1000) / 1000.0;
         fields::SampleTime when;
         when.time = request.time;
         when.fps = project.fps();
@@ -158,10 +162,11 @@ int main(int argc, char** argv) {
     std::printf("  slice 128^2                 %7.2f  (%.2f)\n", slice.median(), slice.max());
     std::printf("  arrows 16^3                 %7.2f  (%.2f)\n", arrows.median(), arrows.max());
     std::printf("  streamlines 256 x <=129     %7.2f  (%.2f)\n", lines.median(), lines.max());
-    std::printf("  JSON (%zu kB)              %7.2f  (%.2f)\n", bytes / 1024, json.median(), json.max());
+    std::printf("  JSON (%zu kB)              %7.2f  (%.2f)\n", bytes / 1024, json.median(),
+                json.max());
     const double t = total.median(), b = baseline.median();
     std::printf("  total edit -> data ready    %7.2f  (%.2f)   goal <= 100\n", t, total.max());
-    std::printf("baseline: %zu points sampled in one batch %.2f ms; marks / baseline = %.2f\n", points, b,
-                (slice.median() + arrows.median() + lines.median()) / b);
+    std::printf("baseline: %zu points sampled in one batch %.2f ms; marks / baseline = %.2f\n",
+                points, b, (slice.median() + arrows.median() + lines.median()) / b);
     return 0;
 }

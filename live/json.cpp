@@ -182,8 +182,12 @@ json fieldJson(const FieldFrame& f, const viz::SliceOverlays& o) {
               {"streamlines", f.times.streamlines}}}};
 }
 
+std::string jsonText(const json& j) {
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 std::string errorJson(const std::string& message) {
-    return json{{"error", message}}.dump();
+    return jsonText(json{{"error", message}});
 }
 
 } // namespace gale::live

@@ -25,6 +25,10 @@ nlohmann::json fieldJson(const FieldFrame& frame, const viz::SliceOverlays& over
 // {"label", "points": [x,y,z,...], "triangles": [i,j,k,...], "polylines": [[i,...],...]}.
 nlohmann::json geometryJson(const viz::GeometryOverlay& g);
 
+// Compact JSON text; bytes that are not UTF-8 (a Latin-1 comment in a source line) become
+// U+FFFD rather than an exception.
+std::string jsonText(const nlohmann::json& j);
+
 // {"error": message}.
 std::string errorJson(const std::string& message);
 

@@ -136,3 +136,16 @@ TEST_CASE("a field view's JSON: sizes and values", "[live][json]") {
     CHECK_FALSE(live::computeFieldFrame(*wind, 24, box, r, f, error));
     CHECK(error.find("res") != std::string::npos);
 }
+
+TEST_CASE("bytes that are not UTF-8 in a source line do not break the JSON", "[live][json]") {
+    TempDir dir;
+    // A Latin-1 comment (0xE9) on the line of a syntax error: the diagnostic's text holds it.
+    const std::string se = dir.write("latin.se", "x = 2 +; # caf\xe9\n[x, 0, 0]\n");
+    live::Project p(se);
+    CHECK_FALSE(p.load());
+    std::string text;
+    REQUIRE_NOTHROW(text = live::jsonText(live::stateJson(p, 0)));
+    CHECK(text.find("caf\xef\xbf\xbd") != std::string::npos); // U+FFFD in its place
+    const nlohmann::json back = nlohmann::json::parse(text);
+    CHECK(back["diagnostics"][0]["line"] == 1);
+}

@@ -391,7 +391,8 @@ bool Project::setParam(const std::string& name, const std::string& field,
         return rewrite(
             p.file,
             [&](std::string& text) {
-                if (text.compare(p.literal.begin, p.literal.end - p.literal.begin, p.text) != 0) {
+                if (p.literal.end > text.size() ||
+                    text.compare(p.literal.begin, p.literal.end - p.literal.begin, p.text) != 0) {
                     error = p.file + " changed since it was read; reload";
                     return false;
                 }
@@ -409,7 +410,8 @@ bool Project::setRamp(int id, const std::vector<RampPoint>& points, std::string&
         return rewrite(
             r.file,
             [&](std::string& text) {
-                if (text.compare(r.literal.begin, r.literal.end - r.literal.begin, r.text) != 0) {
+                if (r.literal.end > text.size() ||
+                    text.compare(r.literal.begin, r.literal.end - r.literal.begin, r.text) != 0) {
                     error = r.file + " changed since it was read; reload";
                     return false;
                 }

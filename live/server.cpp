@@ -114,11 +114,10 @@ public:
           mWatcher([this](const std::set<std::string>& files) { onFilesChanged(files); }, 15),
           mSim(
               [this](long f) {
-                  mEvents.publish("frame", json{{"frame", f}}.dump());
+                  publish("frame", json{{"frame", f}});
               },
               [this](int code, const std::string& log) {
-                  mEvents.publish("sim",
-                                  json{{"running", false}, {"exit", code}, {"log", log}}.dump());
+                  publish("sim", json{{"running", false}, {"exit", code}, {"log", log}});
               }) {
         if (mOpt.token.empty()) mOpt.token = randomToken();
         if (mOpt.webDir.empty()) mOpt.webDir = GALE_LIVE_WEB_DIR;
@@ -180,6 +179,13 @@ public:
     }
 
     int port() const { return mPort; }
+
+    void publish(const std::string& type, const json& data) {
+        mEvents.publish(type, jsonText(data));
+    }
+    static void reply(httplib::Response& res, const json& data) {
+        res.set_content(jsonText(data), kJson);
+    }
     const std::string& token() const { return mOpt.token; }
     std::string url() const {
         return "http://" + (mOpt.host == "0.0.0.0" ? std::string("127.0.0.1") : mOpt.host) + ":" +
@@ -199,6 +205,14 @@ private:
     // A reload after edits: the new files are watched; `field` when it compiled, else
     // `diagnostics`.
     void onFilesChanged(const std::set<std::string>& changed) {
+        try {
+            reloadAndNotify(changed);
+        } catch (const std::exception& e) { // (out of memory): the page hears of it
+            publish("diagnostics", json{{"error", e.what()}});
+        }
+    }
+
+    void reloadAndNotify(const std::set<std::string>& changed) {
         const auto t0 = std::chrono::steady_clock::now();
         json event;
         bool ok;
@@ -213,7 +227,7 @@ private:
                                       .count()}};
         }
         watchProjectFiles();
-        mEvents.publish(ok ? "field" : "diagnostics", event.dump());
+        publish(ok ? "field" : "diagnostics", event);
     }
 
     bool authorised(const httplib::Request& req, httplib::Response& res) {
@@ -281,8 +295,7 @@ private:
             {"style.css", {web + "/style.css", "text/css"}},
             {"three.module.js", {mods + "/three/build/three.module.js", kScript}},
             {"three.core.js", {mods + "/three/build/three.core.js", kScript}},
-            {"OrbitControls.js",
-             {mods + "/three/examples/jsm/controls/OrbitControls.js", kScript}},
+            {"OrbitControls.js", {mods + "/three/examples/jsm/controls/OrbitControls.js", kScript}},
         };
         mHttp.Get(R"(/assets/([A-Za-z0-9_.-]+))",
                   [this, assets](const httplib::Request& req, httplib::Response& res) {
@@ -292,11 +305,11 @@ private:
                   });
         mHttp.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
-            res.set_content(stateJson(mProject, mTime).dump(), kJson);
+            reply(res, stateJson(mProject, mTime));
         });
         mHttp.Get("/api/scene", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
-            res.set_content(sceneJson(mProject).dump(), kJson);
+            reply(res, sceneJson(mProject));
         });
         mHttp.Get("/api/file", [this](const httplib::Request& req, httplib::Response& res) {
             const std::string path =
@@ -312,9 +325,7 @@ private:
                 return fail(res, 403,
                             "not one of the scene's files: " + req.get_param_value("path"));
             if (!readFile(path, text, 4u << 20)) return fail(res, 404, path + ": cannot read");
-            res.set_content(json{{"path", path}, {"text", text}}.dump(
-                                -1, ' ', false, json::error_handler_t::replace),
-                            kJson);
+            reply(res, json{{"path", path}, {"text", text}});
         });
         mHttp.Get("/api/field",
                   [this](const httplib::Request& req, httplib::Response& res) { field(req, res); });
@@ -400,7 +411,7 @@ private:
             overlays = mProject.overlays(r.time);
             mTime = r.time;
         }
-        res.set_content(fieldJson(frame, overlays).dump(), kJson);
+        reply(res, fieldJson(frame, overlays));
     }
 
     void frame(const httplib::Request& req, httplib::Response& res) {
@@ -418,7 +429,7 @@ private:
             g.label = o.name;
             objects.push_back(geometryJson(g));
         }
-        res.set_content(json{{"frame", n}, {"objects", objects}}.dump(), kJson);
+        reply(res, json{{"frame", n}, {"objects", objects}});
     }
 
     bool bodyJson(const httplib::Request& req, httplib::Response& res, json& out) {
@@ -434,7 +445,7 @@ private:
     void replyState(httplib::Response& res) {
         std::lock_guard<std::mutex> lock(mMutex);
         mProject.load();
-        res.set_content(stateJson(mProject, mTime).dump(), kJson);
+        reply(res, stateJson(mProject, mTime));
     }
 
     void setParam(const httplib::Request& req, httplib::Response& res) {
@@ -535,15 +546,13 @@ private:
             std::string error;
             if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
                 return fail(res, 500, error);
-            mEvents.publish(
-                "sim", json{{"running", true}, {"dir", dir}, {"frames", {first, last}}}.dump());
+            publish("sim", json{{"running", true}, {"dir", dir}, {"frames", {first, last}}});
         } else {
             return fail(res, 400, "action: start or stop");
         }
-        res.set_content(
-            json{{"running", mSim.running()}, {"dir", mSim.outDir()}, {"last", mSim.lastFrame()}}
-                .dump(),
-            kJson);
+        reply(
+            res,
+            json{{"running", mSim.running()}, {"dir", mSim.outDir()}, {"last", mSim.lastFrame()}});
     }
 
     ServerOptions mOpt;
