@@ -117,9 +117,8 @@ int runViz(const VizOptions& o) {
         printError(error + " (u0,v0,u1,v1 in the plane's axes)");
         return kExitUsage;
     }
-    // The plane's axes as drawn (u right, v up): z=C shows x,y; y=C shows x,z; x=C shows z,y.
-    const int uAxis = normal == 2 ? 0 : normal == 1 ? 0 : 2;
-    const int vAxis = normal == 2 ? 1 : normal == 1 ? 2 : 1;
+    int uAxis = 0, vAxis = 1;
+    viz::planeAxes(normal, uAxis, vAxis);
     if (!(b[2] > b[0]) || !(b[3] > b[1])) {
         printError("--bounds '" + o.bounds + "': expected " + axisName(uAxis) + "0," +
                    axisName(vAxis) + "0," + axisName(uAxis) + "1," + axisName(vAxis) + "1 with " +

@@ -41,8 +41,7 @@ bool computeFieldFrame(const fields::Field& field, double fps, const viz::Box3& 
     auto t0 = std::chrono::steady_clock::now();
     viz::Slice& s = out.slice;
     s.normalAxis = r.axis;
-    s.uAxis = r.axis == 0 ? 2 : 0;
-    s.vAxis = r.axis == 1 ? 2 : 1;
+    viz::planeAxes(r.axis, s.uAxis, s.vAxis);
     s.planeValue = r.planeValue;
     s.bounds = {box.lo[s.uAxis], box.lo[s.vAxis], box.hi[s.uAxis], box.hi[s.vAxis]};
     const double w = s.bounds[2] - s.bounds[0], h = s.bounds[3] - s.bounds[1];

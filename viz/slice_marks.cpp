@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace gale::viz {
 
@@ -19,6 +20,30 @@ void inPlane(const Slice& s, int col, int row, double& px, double& py) {
 }
 
 } // namespace
+
+void planeAxes(int normal, int& uAxis, int& vAxis) {
+    uAxis = normal == 2 ? 0 : normal == 1 ? 0 : 2;
+    vAxis = normal == 2 ? 1 : normal == 1 ? 2 : 1;
+}
+
+bool geometryBounds(const std::vector<const GeometryOverlay*>& all, int uAxis, int vAxis,
+                    std::array<double, 4>& b) {
+    double lo[2] = {std::numeric_limits<double>::infinity(),
+                    std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (const GeometryOverlay* g : all)
+        for (const auto& p : g->points) {
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+            lo[0] = std::min(lo[0], p[uAxis]);
+            hi[0] = std::max(hi[0], p[uAxis]);
+            lo[1] = std::min(lo[1], p[vAxis]);
+            hi[1] = std::max(hi[1], p[vAxis]);
+        }
+    if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1])) return false;
+    const double pad = std::max(0.05, 0.15 * std::max(hi[0] - lo[0], hi[1] - lo[1]));
+    b = {lo[0] - pad, lo[1] - pad, hi[0] + pad, hi[1] + pad};
+    return true;
+}
 
 fields::SampleStatus sampleSlice(const fields::Field& field, const fields::SampleTime& when,
                                  viz::Slice& slice) {

@@ -11,6 +11,14 @@
 
 namespace gale::viz {
 
+// The plane's axes as drawn (u right, v up): z=C shows x,y; y=C shows x,z; x=C shows z,y.
+void planeAxes(int normal, int& uAxis, int& vAxis);
+
+// The (u, v) extent of every geometry's finite points, padded by 15 % of the larger side (at
+// least 5 cm): u0, v0, u1, v1. False when there is no finite point.
+bool geometryBounds(const std::vector<const GeometryOverlay*>& all, int uAxis, int vAxis,
+                    std::array<double, 4>& bounds);
+
 // The world velocity at the centre of every sample of `slice` (nu, nv, bounds, axes and plane
 // set): positions as slice.velocity's layout, sampled through fields::samplePoints. On a
 // non-finite velocity the status counts it and `slice.velocity` is left empty.
