@@ -27,7 +27,9 @@ function sliceRequest() {
   const plane = box.lo[axis] + Number($('slicePos').value) * (box.hi[axis] - box.lo[axis]);
   $('slicePosText').textContent = 'xyz'[axis] + ' = ' + fmt(plane, 2) + ' m';
   const a = view.rake.a, b = view.rake.b;
-  return `/api/field?t=${time}&axis=${axis}&plane=${plane}&res=128&arrows=16&lines=256` +
+  const arrows = $('showArrows').checked ? $('arrowCount').value : 0;
+  const lines = $('showLines').checked ? $('lineCount').value : 0;
+  return `/api/field?t=${time}&axis=${axis}&plane=${plane}&res=128&arrows=${arrows}&lines=${lines}` +
     `&ax=${a.x}&ay=${a.y}&az=${a.z}&bx=${b.x}&by=${b.y}&bz=${b.z}`;
 }
 
@@ -83,7 +85,8 @@ async function showFile(path) {
 
 async function refreshState(s) {
   state = s || (await api('/api/state'));
-  $('input').textContent = state.input;
+  $('input').textContent = shortPath(state.input);
+  $('input').title = state.input;
   showStatus();
   renderParams($('params'), state.params, async (p, value) => {
     try {
@@ -189,9 +192,14 @@ function events() {
 
 function wire() {
   $('sliceAxis').onchange = refreshField;
+  $('arrowCount').onchange = refreshField;
+  $('lineCount').onchange = refreshField;
   $('slicePos').oninput = refreshField;
   for (const [id, group] of [['showSlice', 'slice'], ['showArrows', 'arrows'], ['showLines', 'lines'], ['showBodies', 'bodies'], ['showRigs', 'rigs']])
-    $(id).onchange = () => view.setVisible(group, $(id).checked);
+    $(id).onchange = () => {
+      view.setVisible(group, $(id).checked);
+      if (group === 'arrows' || group === 'lines') refreshField(); // (not computed while hidden)
+    };
   $('play').onclick = () => {
     playing = !playing;
     $('play').textContent = playing ? '❚❚' : '▶';
