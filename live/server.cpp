@@ -137,6 +137,12 @@ public:
         if (!mWatcher.start(error)) return false;
         watchProjectFiles();
         routes();
+        // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, with which a second
+        // server on the same port would silently share its connections.
+        mHttp.set_socket_options([](int sock) {
+            int yes = 1;
+            setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+        });
         mHttp.set_payload_max_length(64 * 1024);
         mHttp.set_keep_alive_timeout(5);
         mHttp.new_task_queue = [] { return new httplib::ThreadPool(16); };

@@ -27,6 +27,14 @@ json() { printf '%s' "$BODY" | python3 -c "import json,sys; d=json.load(sys.stdi
 expect() { [ "$1" = "$2" ] || fail "$3: got '$1', wanted '$2'"; }
 is_error_json() { printf '%s' "$BODY" | python3 -c "import json,sys; d=json.load(sys.stdin); assert isinstance(d.get('error'), str) and d['error']" 2>/dev/null || fail "$1: not a JSON {\"error\": ...}: $BODY"; }
 
+# ---- the command line ----
+timeout -s TERM 10 "$GALE" live "$TOML" --no-open --port "$PORT" 2>"$TMP/second.err" # (a hang: 124)
+rc=$?
+expect "$rc" 2 "a second server on the same port"
+grep -q "in use" "$TMP/second.err" || fail "the port-in-use message: $(cat "$TMP/second.err")"
+"$GALE" live "$TMP/nosuch.toml" --no-open 2>/dev/null
+expect "$?" 3 "a missing input"
+
 # ---- the token ----
 get /api/state
 expect "$CODE" 403 "no token"
