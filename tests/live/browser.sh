@@ -22,15 +22,6 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
     echo "SKIP: node and npm are needed to drive chromium (apt-get install nodejs npm)" >&2
     exit 77
 fi
-# (GALE_SANITIZE is set by CTest from the build's sanitizers; see the decision in docs/live.md.)
-case "${GALE_SANITIZE:-}" in
-*address* | *thread*)
-    if [ -z "${GALE_BROWSER_UNDER_SANITIZERS:-}" ]; then
-        echo "SKIP: the browser test is skipped in sanitizer builds ($GALE_SANITIZE): software GL beside an instrumented server is too slow for the suite; endpoints.sh covers the server there (GALE_BROWSER_UNDER_SANITIZERS=1 runs it anyway)" >&2
-        exit 77
-    fi
-    ;;
-esac
 MODULES=$BUILD/npm
 if ! cmp -s "$HERE/package-lock.json" "$MODULES/package-lock.json" || [ ! -d "$MODULES/node_modules/puppeteer-core" ]; then
     mkdir -p "$MODULES"
