@@ -195,7 +195,7 @@ post /api/simulate '{"action": "start"}'
 child=$(pgrep -P "$SERVER_PID" | head -1)
 stop_server
 [ -n "$child" ] && kill -0 "$child" 2>/dev/null && { fail "the server's shutdown ends its simulation $child"; kill "$child"; }
-grep -q 'gale live: stopped' "$TMP/server.err" || fail "the server stops cleanly on SIGTERM: $(cat "$TMP/server.err")"
+grep -q 'gale live: stopped' "$SERVER_ERR" || fail "the server stops cleanly on SIGTERM: $(cat "$SERVER_ERR")"
 
 # ---- a lone .se with a ramp ----
 cat > "$TMP/ramp.se" <<'SE'
