@@ -82,8 +82,12 @@ try {
   let n = await page.evaluate(() => window.galeLive.fieldUpdates);
   fs.writeFileSync(se, original.replace(/\+ eddies\s*$/, '+ eddies + [0, 6 * sin($P[0] * 4), 0]\n'));
   await until(() => page.evaluate((n0) => window.galeLive.fieldUpdates > n0, n), 15000, 'an edit of the .se reaches the page');
-  const second = await pixels();
-  check(second.hash !== first.hash, 'the slice\'s pixels change after the .se edit');
+  // (Polled: a field requested before the edit may still be the one drawn.)
+  const second = await until(async () => {
+    const p = await pixels();
+    return p.hash !== first.hash ? p : null;
+  }, 15000, 'the slice\'s pixels change after the .se edit');
+  if (second) check(true, `the slice's pixels change after the .se edit (${second.colours} colours)`);
 
   // A slider: $turbulenceScale (declared and set in the .se) dragged to the right end.
   n = await page.evaluate(() => window.galeLive.stateUpdates);
