@@ -169,6 +169,10 @@ public:
         mStopped = true;
         mEvents.close();
         mSim.stop();
+        if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
+            std::error_code ec;
+            fs::remove_all(mTempDir, ec);
+        }
         mWatcher.stop();
         mHttp.stop();
         if (mThread.joinable()) mThread.join();

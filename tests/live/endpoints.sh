@@ -196,6 +196,7 @@ child=$(pgrep -P "$SERVER_PID" | head -1)
 stop_server
 [ -n "$child" ] && kill -0 "$child" 2>/dev/null && { fail "the server's shutdown ends its simulation $child"; kill "$child"; }
 grep -q 'gale live: stopped' "$SERVER_ERR" || fail "the server stops cleanly on SIGTERM: $(cat "$SERVER_ERR")"
+[ -e "$(dirname "$SIM_DIR")" ] && fail "the server's simulation folder $(dirname "$SIM_DIR") is removed when it stops"
 
 # ---- a lone .se with a ramp ----
 cat > "$TMP/ramp.se" <<'SE'
