@@ -11,7 +11,8 @@ DEB_PACKAGES := g++ cmake ninja-build pkg-config make \
 	libeigen3-dev libfftw3-dev libgsl-dev libopenvdb-dev libboost-iostreams-dev \
 	libtbb-dev catch2 libcli11-dev libtomlplusplus-dev libtinyobjloader-dev \
 	libcairo2-dev libpng-dev parallel \
-	pybind11-dev python3-dev python3-numpy python3-pytest python3
+	pybind11-dev python3-dev python3-numpy python3-pytest python3 \
+	libcpp-httplib-dev nlohmann-json3-dev nodejs curl
 
 .PHONY: all deps configure build demo test test-asan test-tsan fuzz bench report clean format
 
@@ -26,6 +27,9 @@ deps:
 		if [ "$$(id -u)" != 0 ]; then echo "gale: run as root (or install them yourself)"; exit 1; fi; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+	@# npm (for the gale live page's three.js): part of NodeSource's nodejs, Debian's own package otherwise.
+	@command -v npm >/dev/null || { [ "$$(id -u)" = 0 ] && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends npm; } || \
+		echo "gale: npm is missing: the gale live page will lack three.js (apt-get install npm)"
 
 configure: deps
 	@if [ ! -f $(BUILD)/build.ninja ]; then \

@@ -165,4 +165,8 @@ struct WedgeOptions {
 int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);
 
+// `gale live SCENE.toml | FILE.se`: the field in a browser, updated as files change
+// (cli/live_command.cpp; the server is live/).
+Command addLiveCommand(CLI::App& app);
+
 } // namespace gale::cli

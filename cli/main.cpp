@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
         addVizCommand(app),
         addSimCommand(app),
         addWedgeCommand(app),
+        addLiveCommand(app),
     };
 
     wrapAllHelp(app);

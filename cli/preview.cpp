@@ -9,6 +9,7 @@
 #include "scene/load.h"
 #include "solver/scene.h"
 #include "viz/cairo_render.h"
+#include "viz/slice_marks.h"
 
 #include <algorithm>
 #include <cctype>
@@ -160,25 +161,6 @@ std::string jsonText(const Json& j) {
     return "?";
 }
 
-// The (u, v) extent of every geometry, padded; false when there is none.
-bool geometryBounds(const std::vector<const viz::GeometryOverlay*>& all, int uAxis, int vAxis,
-                    std::array<double, 4>& b) {
-    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    double hi[2] = {-lo[0], -lo[1]};
-    for (const viz::GeometryOverlay* g : all)
-        for (const auto& p : g->points) {
-            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
-            lo[0] = std::min(lo[0], p[uAxis]);
-            hi[0] = std::max(hi[0], p[uAxis]);
-            lo[1] = std::min(lo[1], p[vAxis]);
-            hi[1] = std::max(hi[1], p[vAxis]);
-        }
-    if (!(hi[0] >= lo[0]) || !(hi[1] >= lo[1])) return false;
-    const double pad = std::max(0.05, 0.15 * std::max(hi[0] - lo[0], hi[1] - lo[1]));
-    b = {lo[0] - pad, lo[1] - pad, hi[0] + pad, hi[1] + pad};
-    return true;
-}
-
 bool boundsFromFlag(const std::string& text, std::array<double, 4>& b) {
     std::vector<double> v;
     std::string error;
@@ -189,12 +171,6 @@ bool boundsFromFlag(const std::string& text, std::array<double, 4>& b) {
     }
     b = {v[0], v[1], v[2], v[3]};
     return true;
-}
-
-// The plane's axes as drawn (u right, v up): z=C shows x,y; y=C shows x,z; x=C shows z,y.
-void planeAxes(int normal, int& uAxis, int& vAxis) {
-    uAxis = normal == 2 ? 0 : normal == 1 ? 0 : 2;
-    vAxis = normal == 2 ? 1 : normal == 1 ? 2 : 1;
 }
 
 } // namespace
@@ -257,7 +233,7 @@ int runVizFrames(const VizOptions& o) {
         return kExitUsage;
     }
     int uAxis = 0, vAxis = 1;
-    planeAxes(normal, uAxis, vAxis);
+    viz::planeAxes(normal, uAxis, vAxis);
 
     FieldInput input;
     if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
@@ -291,7 +267,7 @@ int runVizFrames(const VizOptions& o) {
     for (auto& [f, gs] : geometry)
         for (const viz::GeometryOverlay& g : gs) all.push_back(&g);
     std::array<double, 4> b{};
-    if (!o.bounds.empty() ? !boundsFromFlag(o.bounds, b) : !geometryBounds(all, uAxis, vAxis, b)) {
+    if (!o.bounds.empty() ? !boundsFromFlag(o.bounds, b) : !viz::geometryBounds(all, uAxis, vAxis, b)) {
         if (o.bounds.empty()) printError("the frames hold no finite points to frame; give --bounds");
         return kExitUsage;
     }
@@ -367,7 +343,7 @@ int runContactSheet(const VizOptions& o) {
         return kExitUsage;
     }
     int uAxis = 0, vAxis = 1;
-    planeAxes(normal, uAxis, vAxis);
+    viz::planeAxes(normal, uAxis, vAxis);
 
     const fs::path manifestPath = fs::path(o.contactSheet) / "manifest.jsonl";
     std::ifstream in(manifestPath);
@@ -455,7 +431,7 @@ int runContactSheet(const VizOptions& o) {
     }
     if (missing > 0) std::cerr << "gale viz: " << missing << " frame file(s) missing; their thumbnails are empty\n";
     std::array<double, 4> b{};
-    if (!o.bounds.empty() ? !boundsFromFlag(o.bounds, b) : !geometryBounds(all, uAxis, vAxis, b)) {
+    if (!o.bounds.empty() ? !boundsFromFlag(o.bounds, b) : !viz::geometryBounds(all, uAxis, vAxis, b)) {
         if (o.bounds.empty()) printError("the frames hold no finite points to frame; give --bounds");
         return kExitUsage;
     }

@@ -7,6 +7,7 @@
 #include "fields/grid_sample.h"
 #include "fields/rigs.h"
 #include "viz/cairo_render.h"
+#include "viz/slice_marks.h"
 
 #include <CLI/CLI.hpp>
 
@@ -76,26 +77,12 @@ std::string axisName(int a) {
 }
 
 int sampleSlice(const FieldInput& input, double t, int threads, viz::Slice& slice) {
-    const int uAxis = slice.uAxis, vAxis = slice.vAxis, normal = slice.normalAxis;
-    const std::array<double, 4>& b = slice.bounds;
-    const double planeValue = slice.planeValue;
-    const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
-    std::vector<double> positions(3 * n), velocities(3 * n, 0.0);
-    for (int row = 0; row < slice.nv; ++row)
-        for (int col = 0; col < slice.nu; ++col) {
-            double* p = positions.data() + 3 * (static_cast<size_t>(row) * slice.nu + col);
-            p[uAxis] = b[0] + (col + 0.5) / slice.nu * (b[2] - b[0]);
-            p[vAxis] = b[3] - (row + 0.5) / slice.nv * (b[3] - b[1]);
-            p[normal] = planeValue;
-        }
     fields::SampleTime when;
     when.time = t;
     when.fps = input.fps;
     when.threads = threads;
-    fields::GridSampleOptions sampling;
-    sampling.threads = threads;
-    fields::SampleStatus status =
-        fields::samplePoints(*input.field, positions.data(), n, when, velocities.data(), sampling);
+    const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
+    const fields::SampleStatus status = viz::sampleSlice(*input.field, when, slice);
     if (!status.ok) {
         printError("cannot sample " + input.name + ": " + status.message);
         return kExitInput;
@@ -106,8 +93,6 @@ int sampleSlice(const FieldInput& input, double t, int threads, viz::Slice& slic
                    formatValue(t, false) + " s; no picture was written");
         return kExitNumeric;
     }
-    slice.velocity.resize(3 * n);
-    for (size_t i = 0; i < 3 * n; ++i) slice.velocity[i] = static_cast<float>(velocities[i]);
     return kExitOk;
 }
 
@@ -132,9 +117,8 @@ int runViz(const VizOptions& o) {
         printError(error + " (u0,v0,u1,v1 in the plane's axes)");
         return kExitUsage;
     }
-    // The plane's axes as drawn (u right, v up): z=C shows x,y; y=C shows x,z; x=C shows z,y.
-    const int uAxis = normal == 2 ? 0 : normal == 1 ? 0 : 2;
-    const int vAxis = normal == 2 ? 1 : normal == 1 ? 2 : 1;
+    int uAxis = 0, vAxis = 1;
+    viz::planeAxes(normal, uAxis, vAxis);
     if (!(b[2] > b[0]) || !(b[3] > b[1])) {
         printError("--bounds '" + o.bounds + "': expected " + axisName(uAxis) + "0," +
                    axisName(vAxis) + "0," + axisName(uAxis) + "1," + axisName(vAxis) + "1 with " +

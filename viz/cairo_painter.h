@@ -120,12 +120,6 @@ public:
     void paint();
 
 private:
-    // In-plane velocity of sample (col,row) in pixel directions (right, down).
-    void inPlane(int col, int row, double& px, double& py) const {
-        const float* v = mSlice.velocity.data() + 3 * (static_cast<size_t>(row) * mSlice.nu + col);
-        px = v[mSlice.uAxis];
-        py = -v[mSlice.vAxis];
-    }
     double metresPerPixel() const { return (mSlice.bounds[2] - mSlice.bounds[0]) / mL.plot.w; }
     // World (u, v) in metres -> picture pixels.
     double pxOfU(double u) const {
@@ -155,10 +149,6 @@ private:
     void clipToPlot();
 
     void drawArrows();
-
-    // Bilinear in-plane direction at plot-relative pixel position (x, y); false outside the
-    // plot or where the flow stalls.
-    bool direction(double x, double y, double& dx, double& dy) const;
 
     // Evenly spaced streamlines (seeded on a grid, RK2 midpoint steps on the normalised
     // in-plane direction, stopped near other lines), each with an arrowhead at its middle.

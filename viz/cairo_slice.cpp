@@ -3,6 +3,7 @@
 // cairo_overlays.cpp), PNG via an image surface, SVG via an SVG surface, both written
 // atomically, and contact sheets of thumbnails.
 #include "viz/cairo_painter.h"
+#include "viz/slice_marks.h"
 
 #include "io/atomic_file.h"
 
@@ -44,16 +45,10 @@ void Painter::paint() {
 }
 
 void Painter::computeSpeeds() {
-    const size_t n = static_cast<size_t>(mSlice.nu) * static_cast<size_t>(mSlice.nv);
-    if (mSlice.velocity.size() < 3 * n) return; // no field sampled: a backdrop instead
-    mSpeed.resize(n);
-    mMaxSpeed = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const float* v = mSlice.velocity.data() + 3 * i;
-        mSpeed[i] = std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
-        mMaxSpeed = std::max(mMaxSpeed, mSpeed[i]);
-    }
-    mScaleTop = mSet.speedMax > 0 ? mSet.speedMax : niceCeil(mMaxSpeed > 0 ? mMaxSpeed : 1.0);
+    SpeedScale scale = speedScale(mSlice, mSet.speedMax);
+    mSpeed = std::move(scale.speed);
+    mMaxSpeed = scale.max;
+    mScaleTop = scale.top;
 }
 
 void Painter::drawTitle() {
@@ -96,8 +91,7 @@ void Painter::drawRaster() {
 }
 
 double Painter::spacing() const {
-    if (mSet.arrowSpacing > 0) return mSet.arrowSpacing;
-    return std::max(26.0 * mS, std::max(mL.plot.w, mL.plot.h) / 22.0);
+    return markSpacing(mSet, mL.plot.w, mL.plot.h, mS);
 }
 
 void Painter::drawBackdrop() {
@@ -200,75 +194,33 @@ void Painter::clipToPlot() {
 }
 
 void Painter::drawArrows() {
-    const double sp = spacing();
-    const int na = std::max(1, static_cast<int>(std::lround(mL.plot.w / sp)));
-    const int nb = std::max(1, static_cast<int>(std::lround(mL.plot.h / sp)));
-    const double cw = mL.plot.w / na, ch = mL.plot.h / nb;
-    struct A {
-        double x, y, vx, vy, m;
-    };
-    std::vector<A> arrows;
-    double ref = 0.0;
-    for (int b = 0; b < nb; ++b)
-        for (int a = 0; a < na; ++a) {
-            const double cx = (a + 0.5) * cw, cy = (b + 0.5) * ch;
-            const int col =
-                std::min(mSlice.nu - 1, static_cast<int>(cx * mSlice.nu / mL.plot.w));
-            const int row =
-                std::min(mSlice.nv - 1, static_cast<int>(cy * mSlice.nv / mL.plot.h));
-            double vx, vy;
-            inPlane(col, row, vx, vy);
-            const double m = std::hypot(vx, vy);
-            ref = std::max(ref, m);
-            arrows.push_back({mL.plot.x + cx, mL.plot.y + cy, vx, vy, m});
-        }
+    const ArrowGrid grid = sliceArrows(mSlice, mL.plot.w, mL.plot.h, spacing());
+    const double ref = grid.reference;
     mArrowRef = ref;
-    mArrowCell = std::min(cw, ch);
+    mArrowCell = grid.cell;
     cairo_save(mCr);
     clipToPlot();
     const double maxLen = 0.9 * mArrowCell;
-    for (const A& a : arrows) {
-        if (ref <= 0 || a.m < 0.03 * ref) {
-            cairo_arc(mCr, a.x, a.y, 1.6 * mS, 0, 2 * M_PI);
+    for (const ArrowMark& a : grid.arrows) {
+        const double ax = mL.plot.x + a.x, ay = mL.plot.y + a.y;
+        if (ref <= 0 || a.magnitude < 0.03 * ref) {
+            cairo_arc(mCr, ax, ay, 1.6 * mS, 0, 2 * M_PI);
             cairo_set_source_rgba(mCr, 1, 1, 1, 0.8);
             cairo_fill(mCr);
             continue;
         }
-        const double len = maxLen * a.m / ref;
-        const double ux = a.vx / a.m, uy = a.vy / a.m;
-        haloArrow(mCr, a.x - 0.5 * len * ux, a.y - 0.5 * len * uy, a.x + 0.5 * len * ux,
-                  a.y + 0.5 * len * uy, std::min(9.0 * mS, 0.4 * maxLen), 1.3 * mS);
+        const double len = maxLen * a.magnitude / ref;
+        const double ux = a.vx / a.magnitude, uy = a.vy / a.magnitude;
+        haloArrow(mCr, ax - 0.5 * len * ux, ay - 0.5 * len * uy, ax + 0.5 * len * ux,
+                  ay + 0.5 * len * uy, std::min(9.0 * mS, 0.4 * maxLen), 1.3 * mS);
     }
     cairo_restore(mCr);
 }
 
-bool Painter::direction(double x, double y, double& dx, double& dy) const {
-    if (x < 0 || y < 0 || x > mL.plot.w || y > mL.plot.h) return false;
-    const double fx = std::clamp(x * mSlice.nu / mL.plot.w - 0.5, 0.0, mSlice.nu - 1.0);
-    const double fy = std::clamp(y * mSlice.nv / mL.plot.h - 0.5, 0.0, mSlice.nv - 1.0);
-    const int c0 = std::min(static_cast<int>(fx), mSlice.nu - 1);
-    const int r0 = std::min(static_cast<int>(fy), mSlice.nv - 1);
-    const int c1 = std::min(c0 + 1, mSlice.nu - 1), r1 = std::min(r0 + 1, mSlice.nv - 1);
-    const double tx = fx - c0, ty = fy - r0;
-    double a[2], b[2], c[2], d[2];
-    inPlane(c0, r0, a[0], a[1]);
-    inPlane(c1, r0, b[0], b[1]);
-    inPlane(c0, r1, c[0], c[1]);
-    inPlane(c1, r1, d[0], d[1]);
-    dx = (1 - ty) * ((1 - tx) * a[0] + tx * b[0]) + ty * ((1 - tx) * c[0] + tx * d[0]);
-    dy = (1 - ty) * ((1 - tx) * a[1] + tx * b[1]) + ty * ((1 - tx) * c[1] + tx * d[1]);
-    const double m = std::hypot(dx, dy);
-    if (!(m > 1e-6 * std::max(mMaxSpeed, 1e-12))) return false;
-    dx /= m;
-    dy /= m;
-    return true;
-}
-
 void Painter::drawStreamlines() {
     const double sep = 0.75 * spacing();
-    const std::vector<Polyline> lines = traceStreamlines(
-        [this](double x, double y, double& dx, double& dy) { return direction(x, y, dx, dy); },
-        mL.plot.w, mL.plot.h, sep, std::max(1.0, 1.5 * mS));
+    const std::vector<Polyline> lines =
+        sliceStreamlines(mSlice, mL.plot.w, mL.plot.h, mMaxSpeed, sep, std::max(1.0, 1.5 * mS));
     cairo_save(mCr);
     clipToPlot();
     cairo_translate(mCr, mL.plot.x, mL.plot.y);

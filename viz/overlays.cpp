@@ -82,6 +82,31 @@ SliceOverlays sceneOverlays(const fields::Scene& scene, double t) {
     return o;
 }
 
+void parseObjGeometry(std::istream& in, GeometryOverlay& out) {
+    auto index = [&](const std::string& word) {
+        const int i = std::atoi(word.c_str()); // "7", "7/1/2": the vertex
+        return i > 0 ? i - 1 : static_cast<int>(out.points.size()) + i;
+    };
+    for (std::string line; std::getline(in, line);) {
+        std::istringstream words(line);
+        std::string tag;
+        words >> tag;
+        if (tag == "v") {
+            std::array<double, 3> p{};
+            words >> p[0] >> p[1] >> p[2];
+            out.points.push_back(p);
+        } else if (tag == "f") {
+            std::vector<int> poly;
+            for (std::string w; words >> w;) poly.push_back(index(w));
+            for (size_t k = 1; k + 1 < poly.size(); ++k) out.triangles.push_back({poly[0], poly[k], poly[k + 1]});
+        } else if (tag == "l") {
+            std::vector<int> line;
+            for (std::string w; words >> w;) line.push_back(index(w));
+            out.polylines.push_back(std::move(line));
+        }
+    }
+}
+
 bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::string& error) {
     out = GeometryOverlay{};
     std::string ext = fs::path(path).extension().string();
@@ -92,28 +117,7 @@ bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::strin
             error = path + ": cannot read: no such file (run gale sim first?)";
             return false;
         }
-        auto index = [&](const std::string& word) {
-            const int i = std::atoi(word.c_str()); // "7", "7/1/2": the vertex
-            return i > 0 ? i - 1 : static_cast<int>(out.points.size()) + i;
-        };
-        for (std::string line; std::getline(in, line);) {
-            std::istringstream words(line);
-            std::string tag;
-            words >> tag;
-            if (tag == "v") {
-                std::array<double, 3> p{};
-                words >> p[0] >> p[1] >> p[2];
-                out.points.push_back(p);
-            } else if (tag == "f") {
-                std::vector<int> poly;
-                for (std::string w; words >> w;) poly.push_back(index(w));
-                for (size_t k = 1; k + 1 < poly.size(); ++k) out.triangles.push_back({poly[0], poly[k], poly[k + 1]});
-            } else if (tag == "l") {
-                std::vector<int> line;
-                for (std::string w; words >> w;) line.push_back(index(w));
-                out.polylines.push_back(std::move(line));
-            }
-        }
+        parseObjGeometry(in, out);
         return true;
     }
     io::PointSet ps;

@@ -1,0 +1,246 @@
+// gale live's page: fetches the state and the field's marks from the server, listens to its
+// Server-Sent Events (a file changed and recompiled, diagnostics, simulated frames) and wires
+// the controls. Every request carries the session token from the page's URL.
+import { View } from 'gale/view.js';
+import { renderParams, renderRamps, renderSource, renderLegend, draggable, Timeline, shortPath, fmt } from 'gale/panels.js';
+
+const token = new URLSearchParams(location.search).get('token') || '';
+const $ = (id) => document.getElementById(id);
+
+async function api(path, body) {
+  const url = path + (path.includes('?') ? '&' : '?') + 'token=' + encodeURIComponent(token);
+  const r = await fetch(url, body === undefined ? {} : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+  const j = await r.json().catch(() => ({ error: 'HTTP ' + r.status }));
+  if (!r.ok) throw new Error(j.error || 'HTTP ' + r.status);
+  return j;
+}
+
+const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null });
+const view = new View($('view'));
+const timeline = new Timeline($('timeline'), (t) => setTime(t));
+let state = null, scene = null, fieldData = null, currentFile = null;
+let time = 0, playing = false, simFrames = [], shownFrame = null;
+
+function sliceRequest() {
+  const axis = Number($('sliceAxis').value);
+  const box = scene.box;
+  const plane = box.lo[axis] + Number($('slicePos').value) * (box.hi[axis] - box.lo[axis]);
+  $('slicePosText').textContent = 'xyz'[axis] + ' = ' + fmt(plane, 2) + ' m';
+  const a = view.rake.a, b = view.rake.b;
+  const arrows = $('showArrows').checked ? $('arrowCount').value : 0;
+  const lines = $('showLines').checked ? $('lineCount').value : 0;
+  return `/api/field?t=${time}&axis=${axis}&plane=${plane}&res=128&arrows=${arrows}&lines=${lines}` +
+    `&ax=${a.x}&ay=${a.y}&az=${a.z}&bx=${b.x}&by=${b.y}&bz=${b.z}`;
+}
+
+// One field request in flight at a time; a newer wish replaces a queued one.
+let inFlight = false, queued = false;
+async function refreshField() {
+  if (!scene || !state || !state.ok) return;
+  if (inFlight) { queued = true; return; }
+  inFlight = true;
+  try {
+    const t0 = performance.now();
+    fieldData = await api(sliceRequest());
+    const t1 = performance.now();
+    const s = fieldData.slice, map = s.colormap;
+    view.setSlice(s, map);
+    view.setArrows(fieldData.arrows, map, s.top);
+    view.setStreamlines(fieldData.streamlines, map, s.top);
+    view.setRigs(fieldData.overlays);
+    view.render();
+    renderLegend($('legendBar'), $('legendTicks'), $('legendMax'), map, s.top, s.max);
+    const w = fieldData.overlays.windicator;
+    $('windicator').textContent = w.present ? `windicator ${fmt(w.speed, 2)} m/s → [${w.direction.map((c) => fmt(c, 2)).join(', ')}]` : '';
+    timeline.set(fieldData.overlays.timeline, state.fps, state.frames);
+    live.fieldUpdates++;
+    live.lastFieldMs = { fetch: t1 - t0, draw: performance.now() - t1 };
+  } catch (e) {
+    live.errors.push(String(e.message || e));
+  } finally {
+    inFlight = false;
+    if (queued) { queued = false; refreshField(); }
+  }
+}
+
+function showStatus() {
+  const errs = state.diagnostics.filter((d) => d.severity === 'error');
+  $('status').textContent = state.ok ? 'compiled' : `${errs.length || 1} error${errs.length === 1 ? '' : 's'}`;
+  $('status').className = 'pill ' + (state.ok ? 'ok' : 'err');
+  const banner = $('diagBanner');
+  banner.textContent = state.diagnostics.map((d) => d.line ? `${d.file}:${d.line}:${d.col}: ${d.severity}: ${d.message}` : `${d.file}: ${d.severity}: ${d.message}`).join('\n');
+  banner.classList.toggle('hidden', state.diagnostics.length === 0);
+}
+
+async function showFile(path) {
+  currentFile = path;
+  for (const b of $('fileTabs').children) b.classList.toggle('on', b.dataset.path === path);
+  try {
+    const f = await api('/api/file?path=' + encodeURIComponent(path));
+    renderSource($('source'), path, f.text, state.diagnostics);
+  } catch (e) {
+    $('source').textContent = String(e.message || e);
+  }
+}
+
+async function refreshState(s) {
+  state = s || (await api('/api/state'));
+  $('input').textContent = shortPath(state.input);
+  $('input').title = state.input;
+  showStatus();
+  renderParams($('params'), state.params, async (p, value) => {
+    try {
+      state = await api('/api/param', { name: p.name, field: p.field, value });
+      showStatus();
+    } catch (e) {
+      live.errors.push(String(e.message || e));
+    }
+  });
+  renderRamps($('ramps'), state.ramps, async (r, points) => {
+    try {
+      state = await api('/api/ramp', { id: r.id, points });
+      showStatus();
+    } catch (e) {
+      live.errors.push(String(e.message || e));
+    }
+  });
+  const texts = state.files.filter((f) => /\.(se|toml)$/i.test(f));
+  const tabs = $('fileTabs');
+  tabs.replaceChildren(...texts.map((f) => {
+    const b = document.createElement('button');
+    b.textContent = shortPath(f).split('/').pop();
+    b.dataset.path = f;
+    b.onclick = () => showFile(f);
+    return b;
+  }));
+  // Show the file with the first error, else the one shown, else the first expression.
+  const bad = state.diagnostics.find((d) => texts.includes(d.file));
+  const pick = bad ? bad.file : texts.includes(currentFile) ? currentFile : texts.find((f) => f.endsWith('.se')) || texts[0];
+  if (pick) await showFile(pick);
+  live.stateUpdates++;
+}
+
+async function refreshScene() {
+  scene = await api('/api/scene');
+  view.setBox(scene.box);
+  view.setBodies(scene.rest, scene.colliders);
+}
+
+function setTime(t) {
+  time = Math.max(0, t);
+  timeline.t = time;
+  timeline.draw();
+  $('timeText').textContent = `t = ${time.toFixed(3)} s · frame ${fmt(time * (state ? state.fps : 24), 1)}`;
+  if (simFrames.length) showSimFrame(Math.round(time * state.fps));
+  refreshField();
+}
+
+async function showSimFrame(f) {
+  const have = simFrames.filter((x) => x <= f);
+  const n = have.length ? have[have.length - 1] : null;
+  if (n === null || n === shownFrame) return;
+  shownFrame = n;
+  try {
+    const fr = await api('/api/frame?n=' + n);
+    view.setSimFrame(fr.objects);
+    live.simFrameShown = n;
+  } catch (e) {
+    live.errors.push(String(e.message || e));
+  }
+}
+
+// Playing advances $t in real time; the view shows the newest field that has arrived.
+let last = null;
+function tick(now) {
+  if (playing) {
+    if (last !== null) {
+      const [t0, t1] = timeline.range;
+      let t = time + (now - last) / 1000;
+      if (t > t1) t = t0;
+      setTime(t);
+    }
+    last = now;
+    requestAnimationFrame(tick);
+  } else {
+    last = null;
+  }
+}
+
+function events() {
+  const es = new EventSource('/api/events?token=' + encodeURIComponent(token));
+  es.addEventListener('field', async () => {
+    await refreshState();
+    await refreshScene();
+    refreshField();
+  });
+  es.addEventListener('diagnostics', () => refreshState());
+  es.addEventListener('frame', (e) => {
+    const f = JSON.parse(e.data).frame;
+    simFrames.push(f);
+    timeline.simFrames = simFrames;
+    $('simText').textContent = `frame ${f} of ${state.frames[1]}`;
+    if (!playing) setTime(f / state.fps);
+  });
+  es.addEventListener('sim', (e) => {
+    const s = JSON.parse(e.data);
+    $('simulate').textContent = s.running ? 'Stop' : 'Simulate';
+    if (!s.running) $('simText').textContent = s.exit === 0 ? `done: ${simFrames.length} frames` : s.exit === -1 ? 'stopped' : `gale sim failed (exit ${s.exit}): ` + (s.log || '').trim().split('\n').pop();
+  });
+  es.onerror = () => { $('status').textContent = 'reconnecting…'; };
+  es.onopen = () => { if (state) showStatus(); };
+}
+
+function wire() {
+  $('sliceAxis').onchange = refreshField;
+  $('arrowCount').onchange = refreshField;
+  $('lineCount').onchange = refreshField;
+  $('slicePos').oninput = refreshField;
+  for (const [id, group] of [['showSlice', 'slice'], ['showArrows', 'arrows'], ['showLines', 'lines'], ['showBodies', 'bodies'], ['showRigs', 'rigs']])
+    $(id).onchange = () => {
+      view.setVisible(group, $(id).checked);
+      if (group === 'arrows' || group === 'lines') refreshField(); // (not computed while hidden)
+    };
+  $('play').onclick = () => {
+    playing = !playing;
+    $('play').textContent = playing ? '❚❚' : '▶';
+    if (playing) requestAnimationFrame(tick);
+  };
+  $('simulate').onclick = async () => {
+    try {
+      const running = $('simulate').textContent === 'Stop';
+      if (!running) {
+        simFrames = [];
+        shownFrame = null;
+        timeline.simFrames = simFrames;
+        view.setSimFrame([]);
+      }
+      const r = await api('/api/simulate', { action: running ? 'stop' : 'start' });
+      $('simulate').textContent = r.running ? 'Stop' : 'Simulate';
+      $('simText').textContent = r.running ? 'simulating…' : '';
+    } catch (e) {
+      $('simText').textContent = String(e.message || e);
+    }
+  };
+  view.onRakeMoved = refreshField;
+  draggable($('legend'));
+  window.addEventListener('keydown', (e) => {
+    if (e.target.tagName === 'INPUT') return;
+    if (e.key === ' ') { e.preventDefault(); $('play').click(); }
+  });
+}
+
+(async () => {
+  live.loadedAt = performance.now();
+  try {
+    wire();
+    events();
+    await refreshScene();
+    await refreshState();
+    setTime(0);
+    live.ready = true;
+  } catch (e) {
+    live.errors.push(String(e.message || e));
+    $('status').textContent = String(e.message || e);
+    $('status').className = 'pill err';
+  }
+})();
