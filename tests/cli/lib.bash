@@ -61,3 +61,28 @@ wait_file() {
     done
     return 1
 }
+
+# tiny_scene LAST RES WIND_X: the small scene the wedge, farm and cache tests share: a 0.5 m sheet
+# of RES x RES vertices pinned along its top in a swaying breeze, frames 1..LAST, 4 substeps.
+tiny_scene() {
+    cat <<TOML
+[scene]
+fps = 24
+frames = [1, $1]
+substeps = 4
+
+[[field]]
+name = "main"
+source = "[$3, 0, 2 * sin(6 * \$t)]"
+
+[[cloth]]
+name = "c"
+grid = { size = [0.5, 0.5], res = [$2, $2], origin = [-0.25, 0.5, 0], axes = "xy" }
+density = 0.1
+stretch = 500.0
+shear = 50.0
+lift = 0.3
+drag = 1.0
+pins = { box = [-1, 0.99, -1, 1, 1.01, 1] }
+TOML
+}

@@ -5,26 +5,7 @@
 source "$(dirname "$0")/lib.bash" "$@"
 PY=/usr/bin/python3
 
-cat > tiny.toml <<'TOML'
-[scene]
-fps = 24
-frames = [1, 90]
-substeps = 4
-
-[[field]]
-name = "main"
-source = "[4, 0, 2 * sin(6 * $t)]"
-
-[[cloth]]
-name = "c"
-grid = { size = [0.5, 0.5], res = [24, 24], origin = [-0.25, 0.5, 0], axes = "xy" }
-density = 0.1
-stretch = 500.0
-shear = 50.0
-lift = 0.3
-drag = 1.0
-pins = { box = [-1, 0.99, -1, 1, 1.01, 1] }
-TOML
+tiny_scene 90 24 4 > tiny.toml
 
 # check_mdd FILE OBJ_PREFIX FIRST: the header matches the size, the times are frame/24 from
 # FIRST, and every frame equals its OBJ (9 significant digits) in float32; prints the frame count.

@@ -119,26 +119,7 @@ wait_job() {
     return 1
 }
 
-cat > tiny.toml <<'TOML'
-[scene]
-fps = 24
-frames = [1, 24]
-substeps = 4
-
-[[field]]
-name = "main"
-source = "[4, 0, 2 * sin(6 * $t)]"
-
-[[cloth]]
-name = "c"
-grid = { size = [0.5, 0.5], res = [12, 12], origin = [-0.25, 0.5, 0], axes = "xy" }
-density = 0.1
-stretch = 500.0
-shear = 50.0
-lift = 0.3
-drag = 1.0
-pins = { box = [-1, 0.99, -1, 1, 1.01, 1] }
-TOML
+tiny_scene 24 12 4 > tiny.toml
 
 # ---- a 4-variant wedge, submitted ----
 run "$GALE" wedge tiny.toml --vary cloth.c.lift=0.1,0.3 --vary cloth.c.drag=0.8,1.2 -o w --farm slurm --submit \
