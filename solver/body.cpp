@@ -280,11 +280,11 @@ void Body::skewProduct(const VecX& x, VecX& y) const {
     y.setZero(x.size());
     for (const AeroCoupling& c : mAero) {
         if (c.v[0] < 0) continue;
-        Vec3 w = c.axis.cross(cornerSum(c, x));
         if (mAeroPosition && c.v[2] >= 0) {
-            // The orientation part less its PSD part (which is in A).
+            // Newton's full Jacobian: all of ∂F/∂v beyond the damping in A, and the orientation
+            // part less its PSD part (which is in A too).
             const Vec3 d0 = x.segment<3>(3 * c.v[0]);
-            w += c.velocityRest * cornerSum(c, x);
+            Vec3 w = c.velocityRest * cornerSum(c, x);
             w += c.position * ((x.segment<3>(3 * c.v[1]) - d0).cross(c.e2) +
                                c.e1.cross(x.segment<3>(3 * c.v[2]) - d0));
             const Mat9& psd = mAeroPsd[static_cast<size_t>(&c - mAero.data())];
@@ -294,6 +294,7 @@ void Body::skewProduct(const VecX& x, VecX& y) const {
             for (int k = 0; k < 3; ++k) y.segment<3>(3 * c.v[k]) += w - px.segment<3>(3 * k);
             continue;
         }
+        const Vec3 w = c.axis.cross(cornerSum(c, x));
         for (int k = 0; k < 3; ++k)
             if (c.v[k] >= 0) y.segment<3>(3 * c.v[k]) += w;
     }

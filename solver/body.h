@@ -126,8 +126,9 @@ struct AeroCoupling {
     // P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner).
     Mat3 position = Mat3::Zero();
     Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero();
-    // ... and what `damping` and `axis` leave out of the exact (h/9)∂F/∂v (the clamped negative
-    // part, a gated skew part): Newton's iterations solve with the exact Jacobian.
+    // ... and what `damping` leaves out of the exact (h/9)∂F/∂v (its whole skew part, ungated,
+    // and the clamped negative part): Newton's iterations solve with the exact Jacobian, this
+    // in place of `axis`.
     Mat3 velocityRest = Mat3::Zero();
 };
 
@@ -239,8 +240,8 @@ private:
     // there); returns max |Aᵢᵢ⁻¹ S gᵢ| (m/s), infinite when not finite.
     double residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h, ForceInput& in,
                       ForceOutput& out, const Vec3& gravity, bool withMatrix);
-    // y = B x, B the skew part of the couplings in mAero; aeroQuadratic: xᵀ D x of their
-    // symmetric part.
+    // y = B x, B the skew part of the couplings in mAero (in Newton's iterations, mAeroPosition,
+    // all of the Jacobian the assembled A lacks); aeroQuadratic: xᵀ D x of their symmetric part.
     void skewProduct(const VecX& x, VecX& y) const;
     double aeroQuadratic(const VecX& x) const;
     // The linear solve of the step with the assembled matrix and the skew couplings.

@@ -242,7 +242,7 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                             c.velocityRest = (h / 9.0) * aeroTriangleExactJacobian(
                                                              wind - u, areaNormal, in.airDensity,
                                                              cl, cd, mMat.aeroModel) -
-                                             hD9 - crossMatrix(c.axis);
+                                             hD9;
                             if (out.aeroPsd && A) {
                                 (*out.aeroPsd)[e] = orientationPsd(c);
                                 const Mat9& s9 = (*out.aeroPsd)[e];
