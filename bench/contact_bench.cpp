@@ -5,6 +5,7 @@
 // and the substeps (a ball at 5 m/s into a free sheet: the closest approach to the surface and
 // the cost per frame).
 // Usage: gale_bench_contact [steps=24]
+#include "geometry/geometry.h"
 #include "solver/cloth.h"
 #include "solver/collider.h"
 #include "solver/moving_collider.h"
@@ -33,25 +34,11 @@ struct Sphere {
 // A UV sphere of radius r with about `triangles` triangles.
 Sphere sphere(double r, int triangles) {
     const int nlon = static_cast<int>(std::sqrt(triangles)), nlat = triangles / (2 * nlon) + 1;
+    const gale::geometry::TriangleMesh m = gale::geometry::uvSphereMesh({0, 0, 0}, r, nlat, nlon);
     Sphere s;
-    s.pos.insert(s.pos.end(), {0, 0, r});
-    for (int i = 1; i < nlat; ++i)
-        for (int j = 0; j < nlon; ++j) {
-            const double th = M_PI * i / nlat, ph = 2 * M_PI * j / nlon;
-            s.pos.insert(s.pos.end(), {r * std::sin(th) * std::cos(ph),
-                                       r * std::sin(th) * std::sin(ph), r * std::cos(th)});
-        }
-    s.pos.insert(s.pos.end(), {0, 0, -r});
-    const int south = 1 + (nlat - 1) * nlon;
-    auto ring = [&](int i, int j) { return 1 + (i - 1) * nlon + (j % nlon); };
-    for (int j = 0; j < nlon; ++j) s.tris.push_back({0, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i + 1 < nlat; ++i)
-        for (int j = 0; j < nlon; ++j) {
-            s.tris.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-            s.tris.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-        }
-    for (int j = 0; j < nlon; ++j)
-        s.tris.push_back({south, ring(nlat - 1, j + 1), ring(nlat - 1, j)});
+    for (const auto& p : m.points) s.pos.insert(s.pos.end(), {p[0], p[1], p[2]});
+    for (const auto& t : m.triangles)
+        s.tris.push_back({static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2])});
     return s;
 }
 
