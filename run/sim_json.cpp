@@ -86,7 +86,9 @@ std::string settingsJson(const solver::SimScene& sc,
           << (m.aeroModel == solver::AeroModel::Frozen ? "frozen" : "smooth-lift")
           << "\", \"aero_jacobian\": \""
           << (c.step.aeroJacobian == solver::AeroJacobian::Paper ? "paper" : "projected") << "\", "
-          << stepJson(c.step) << ", \"output\": \"" << c.output << "\"}";
+          << stepJson(c.step) << ", \"self_collision\": " << (c.collision.self ? "true" : "false")
+          << ", \"thickness\": " << num(c.collision.thickness) << ", \"output\": \"" << c.output
+          << "\"}";
     }
     for (const solver::HairSpec& h : sc.hairs) {
         const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
@@ -143,13 +145,28 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"potential\": " << num(b.potential)
           << ", \"total\": " << num(b.kinetic + b.elastic + b.potential)
           << "}, \"wind_non_finite\": " << b.windNonFinite
-          << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
+          << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts;
+        if (b.selfIntersections >= 0) o << ", \"self_intersections\": " << b.selfIntersections;
+        o
           << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";
         for (size_t e = 0; e < b.events.size(); ++e)
             o << (e ? ", " : "") << jsonString(b.events[e]);
         o << "]}";
     }
-    o << "]}";
+    o << "]";
+    if (f.selfCollision) {
+        const solver::SelfCollisionStats& s = f.selfContacts;
+        o << ", \"self_collision\": {\"passes\": " << s.passes
+          << ", \"proximity_pairs\": " << s.proximityPairs << ", \"ccd_hits\": " << s.ccdHits
+          << ", \"ccd_rounds\": " << s.ccdRounds << ", \"fail_safe_runs\": " << s.failSafeRuns
+          << ", \"zone_vertices\": " << s.zoneVertices
+          << ", \"frozen_vertices\": " << s.frozenVertices << ", \"unresolved\": " << s.unresolved
+          << ", \"start_touching\": " << s.startTouching
+          << ", \"seconds\": {\"broad\": " << num(s.broadSeconds)
+          << ", \"proximity\": " << num(s.proximitySeconds) << ", \"ccd\": " << num(s.ccdSeconds)
+          << ", \"fail_safe\": " << num(s.failSafeSeconds) << "}}";
+    }
+    o << "}";
     return o.str();
 }
 

@@ -40,7 +40,8 @@ std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
 }
 const std::vector<std::string> kClothKeys =
     withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
-                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh", "attach"});
+                  "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh", "attach",
+                  "self_collision", "thickness"});
 const std::vector<std::string> kHairKeys =
     withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
                   "drag_normal", "drag_tangent", "root_pinned", "rest_shape", "attach"});
@@ -468,6 +469,11 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
     if (const toml::node* n = t.get("attach"))
         c.hasAttach = attach(*n, what + " attach", baseDir, true, c.attach, c.attachMesh);
     if (const toml::node* n = t.get("rest_shape")) choice(*n, "rest_shape", {"mesh", "flat"}, c.restShape);
+    if (const toml::node* n = t.get("self_collision"))
+        boolean(*n, what + ": self_collision", c.collision.self);
+    if (const toml::node* n = t.get("thickness"))
+        c.collision.thicknessForColliders =
+            number(*n, what + ": thickness (m)", c.collision.thickness, 0.0, true);
     if (const toml::node* n = t.get("rest_mesh")) {
         std::string file;
         c.restLine = static_cast<int>(n->source().begin.line);

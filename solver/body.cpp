@@ -199,13 +199,15 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     if (!env.colliders || env.colliders->empty()) return;
     const size_t n = vertexCount();
     for (const Collider& c : *env.colliders) {
-        if (c.moving) c.moving->prepare(t, t + h, c.thickness); // the step's tree (moving_collider.h)
-        const ColliderPose pose = colliderPose(c, t);
+        const double thick = colliderThickness(c);
+        if (c.moving) c.moving->prepare(t, t + h, thick); // the step's tree (moving_collider.h)
+        ColliderPose pose = colliderPose(c, t);
+        if (c.moving) pose.searchRadius = std::max(pose.searchRadius, 2.0 * thick + 1e-3);
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1) continue; // pinned or held
             const Vec3 x = vec3At(mX.data(), i);
             const ContactPoint cp = queryCollider(pose, x);
-            if (!(cp.distance < c.thickness + kContactSlop)) continue;
+            if (!(cp.distance < thick + kContactSlop)) continue;
             // Predicted normal speed relative to the surface without the constraint: keep
             // the vertex on the surface only if it would move in (no adhesion).
             const Vec3 v0 = vec3At(mV.data(), i);
@@ -226,16 +228,18 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
     const size_t n = vertexCount();
     std::vector<uint8_t> touched(n, 0);
     for (const Collider& c : *env.colliders) {
-        const ColliderPose pose = colliderPose(c, t1);
+        const double thick = colliderThickness(c);
+        ColliderPose pose = colliderPose(c, t1);
+        if (c.moving) pose.searchRadius = std::max(pose.searchRadius, 2.0 * thick + 1e-3);
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1) continue;
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
             const ContactPoint cp = queryCollider(pose, x);
             const bool held = mContactCollider[i] == static_cast<int>(&c - env.colliders->data());
             if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
-            if (!(cp.distance < c.thickness) && !held) continue;
+            if (!(cp.distance < thick) && !held) continue;
             touched[i] = 1;
-            if (cp.distance < c.thickness) x += (c.thickness - cp.distance) * cp.normal;
+            if (cp.distance < thick) x += (thick - cp.distance) * cp.normal;
             Eigen::Map<Vec3> v(mV.data() + 3 * i);
             Vec3 rel = v - cp.velocity;
             double impulse = mContactImpulse[i]; // m/s removed by the constraint in the solve
@@ -768,7 +772,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             if (c.moving) {
                 std::vector<uint8_t> movable(n);
                 for (size_t i = 0; i < n; ++i) movable[i] = mConstraints.kind[i] != 1;
-                c.moving->sweep(x0, mX, mV, movable, mEdges, c.thickness, c.friction, h);
+                c.moving->sweep(x0, mX, mV, movable, mEdges, colliderThickness(c), c.friction, h);
             }
     st.contacts = resolveContacts(env, t + h, h);
 

@@ -10,6 +10,7 @@
 #include "solver/linear.h"
 #include "solver/types.h"
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <string>
@@ -84,6 +85,16 @@ struct Environment {
     double fps = 24.0;
     int threads = 1;
     int substepIndex = 0;
+};
+
+// Contact settings of a body (cloth): cloth–cloth collision (solver/self_collision.h) and the
+// collision thickness ξ (m) it keeps from itself and other cloth; against colliders the larger
+// of ξ and the collider's own thickness applies when `thicknessForColliders` is set (a cloth
+// with an explicit `thickness` in the scene).
+struct CollisionSettings {
+    bool self = false;
+    double thickness = 0.003;
+    bool thicknessForColliders = false;
 };
 
 // Why a substep was rejected (the caller halves the step and retries).
@@ -176,6 +187,11 @@ public:
     StepOptions& options() { return mOptions; }
     const StepOptions& options() const { return mOptions; }
     TroubleLimits& limits() { return mLimits; }
+    CollisionSettings& collision() { return mCollision; }
+    const CollisionSettings& collision() const { return mCollision; }
+    // The triangles cloth–cloth contact sees (null: a body without a surface, e.g. hair).
+    virtual const std::vector<std::array<int, 3>>* collisionTriangles() const { return nullptr; }
+    const VecX& restPositions() const { return mRest; } // 3 per vertex (m)
 
     void addPins(const PinSet& pins);
     const std::vector<int>& pinnedVertices() const { return mPinned; }
@@ -230,8 +246,14 @@ protected:
     VecX mX, mV, mMass, mRest;
     StepOptions mOptions;
     TroubleLimits mLimits;
+    CollisionSettings mCollision;
 
 private:
+    // The thickness kept from collider c (m): its own, or the body's when larger and asked for.
+    double colliderThickness(const Collider& c) const {
+        return mCollision.thicknessForColliders ? std::max(c.thickness, mCollision.thickness)
+                                                : c.thickness;
+    }
     void contactConstraints(const Environment& env, double t, double h);
     int resolveContacts(const Environment& env, double t1, double h);
     void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,

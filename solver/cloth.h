@@ -40,6 +40,9 @@ public:
 
     bool feelsWind() const override { return !mMat.lift.alwaysZero() || !mMat.drag.alwaysZero(); }
     const char* kind() const override { return "cloth"; }
+    const std::vector<std::array<int, 3>>* collisionTriangles() const override {
+        return &mMesh.triangles;
+    }
 
 protected:
     void couplings(std::vector<std::pair<int, int>>& pairs) const override;

@@ -59,6 +59,9 @@ struct ClothSpec {
     PinSpec attach;
     std::string attachMesh; // resolved
     StepOptions step;
+    // self_collision / thickness (body.h, CollisionSettings): cloth against itself and the other
+    // cloth with it on; an explicit thickness also applies against colliders (the larger wins).
+    CollisionSettings collision;
     std::string output = "obj"; // obj | ply
     int line = 0, col = 0;
 };

@@ -318,6 +318,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
                                            static_cast<long>(mesh.positions.size()));
         auto cloth = std::make_unique<Cloth>(spec.name, rest, mat, hasRest ? &start : nullptr);
         cloth->options() = spec.step;
+        cloth->collision() = spec.collision;
         cloth->limits().overStretch = scene.solver.overStretch;
         cloth->limits().velocityJump = scene.solver.velocityJump;
         if (cloth->degenerateTriangles())

@@ -5,6 +5,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -43,21 +44,94 @@ FrameStats World::advance(double t0, double dt, int substeps) {
     fs.time = t0 + dt;
     const auto start = std::chrono::steady_clock::now();
     fs.bodies.resize(mBodies.size());
+    substeps = std::max(substeps, 1);
     mArena->arena.execute([&] {
+        if (!mSelfSetUp) setUpSelfCollision(fs);
+        if (mSelf) advanceColliding(t0, dt, substeps, fs);
         for (size_t b = 0; b < mBodies.size(); ++b) {
-            advanceBody(*mBodies[b], t0, dt, std::max(substeps, 1), fs.bodies[b]);
-            fs.failed = fs.failed || fs.bodies[b].failed;
+            if (mSelf && std::find(mSelfBodies.begin(), mSelfBodies.end(), b) != mSelfBodies.end())
+                continue;
+            advanceBody(*mBodies[b], t0, dt, substeps, fs.bodies[b]);
         }
+        for (const BodyFrameStats& b : fs.bodies) fs.failed = fs.failed || b.failed;
     });
-    fs.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fs.wallSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return fs;
 }
 
+void World::setUpSelfCollision(FrameStats& fs) {
+    mSelfSetUp = true;
+    auto self = std::make_unique<SelfCollision>();
+    for (size_t b = 0; b < mBodies.size(); ++b) {
+        Body& body = *mBodies[b];
+        const auto* tris = body.collisionTriangles();
+        if (!body.collision().self || !tris) continue;
+        self->addBody(body, *tris, body.restPositions(), body.collision().thickness);
+        mSelfBodies.push_back(b);
+    }
+    if (mSelfBodies.empty()) return;
+    mSelf = std::move(self);
+    // A start that already intersects cannot be untangled; the passes keep it from worsening.
+    const std::vector<int> start = mSelf->intersectionsPerBody();
+    char buf[256];
+    for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+        if (start[k] == 0) continue;
+        std::snprintf(buf, sizeof buf,
+                      "self-collision: the start shape has %d intersecting triangle pair(s); "
+                      "they are kept from getting worse but not undone (untangle the mesh to "
+                      "remove them)",
+                      start[k]);
+        fs.bodies[mSelfBodies[k]].events.push_back(buf);
+    }
+}
+
+// The colliding bodies advance in lockstep, one base substep at a time (each with its own
+// halving inside it), then one self-collision pass over the straight path from the substep's
+// start to its end (self_collision.h): the end state has no crossing the start did not have.
+void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs) {
+    fs.selfCollision = true;
+    const long ticksPerBase = 1L << std::clamp(mSettings.maxHalvings, 0, 20);
+    std::vector<BodyRun> runs(mSelfBodies.size());
+    std::vector<VecX> starts(mSelfBodies.size());
+    char buf[256];
+    for (int s = 0; s < substeps; ++s) {
+        for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+            Body& body = *mBodies[mSelfBodies[k]];
+            starts[k] = body.positions();
+            stepBody(body, t0, dt, substeps, ticksPerBase * (s + 1), runs[k],
+                     fs.bodies[mSelfBodies[k]]);
+        }
+        const SelfCollisionStats st = mSelf->resolve(starts);
+        fs.selfContacts.add(st);
+        if (st.unresolved > 0) {
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision left %lld pair(s) unresolved after the "
+                          "fail-safe (pins or attachments moving apart inside an impact zone)",
+                          t0 + dt * (s + 1) / substeps, st.unresolved);
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+        }
+    }
+    const std::vector<int> pairs = mSelf->intersectionsPerBody();
+    for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+        BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
+        finishBodyStats(*mBodies[mSelfBodies[k]], t0 + dt, stats);
+        stats.selfIntersections = pairs[k];
+    }
+}
+
 void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats) {
+    BodyRun run;
+    const long ticksPerBase = 1L << std::clamp(mSettings.maxHalvings, 0, 20);
+    stepBody(body, t0, dt, substeps, ticksPerBase * substeps, run, stats);
+    finishBodyStats(body, t0 + dt, stats);
+}
+
+void World::stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
+                     BodyFrameStats& stats) {
     stats.name = body.name();
     const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
     const long ticksPerBase = 1L << maxLevel;
-    const long totalTicks = ticksPerBase * substeps;
     const double hBase = dt / substeps;
     Environment env;
     env.wind = mWind.get();
@@ -66,13 +140,14 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
     env.colliders = &mColliders;
     env.fps = mSettings.fps;
     env.threads = mSettings.threads;
-    long tick = 0;
-    int level = 0;
-    int index = 0;
+    long& tick = run.tick;
+    int& level = run.level;
+    int& index = run.index;
     char buf[512];
-    while (tick < totalTicks) {
+    while (tick < untilTick && !run.stopped) {
         const double h = hBase / static_cast<double>(1L << level);
-        const double t = t0 + hBase * (static_cast<double>(tick) / static_cast<double>(ticksPerBase));
+        const double t =
+            t0 + hBase * (static_cast<double>(tick) / static_cast<double>(ticksPerBase));
         env.substepIndex = index;
         const Body::Snapshot snap = body.snapshot();
         SubstepStatus st = body.substep(env, t, h);
@@ -81,7 +156,8 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
         const int newton = body.options().newtonIterations;
         if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
             newton < kRetryNewtonIterations && !mSettings.noNewtonRetry) {
-            std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
                           troubleName(st.trouble), st.reason.c_str(), kRetryNewtonIterations);
             body.restore(snap);
             // The retry wants the line search's cut of an over-stretching step, not convergence:
@@ -95,7 +171,9 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
             body.options().newtonFullJacobian = full;
             st.iterations += firstIterations;
             ++stats.newtonRetries;
-            stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None ? ": accepted" : ": still in trouble"));
+            stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None
+                                                           ? ": accepted"
+                                                           : ": still in trouble"));
         }
         stats.iterations += st.iterations;
         stats.maxIterations = std::max(stats.maxIterations, st.iterations);
@@ -137,6 +215,7 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
                 body.restore(snap);
                 stats.failed = true;
                 stats.events.push_back("run failed: the recovered state is not finite");
+                run.stopped = true;
                 break;
             }
         }
@@ -145,6 +224,9 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
         ++stats.substeps;
         ++index;
     }
+}
+
+void World::finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const {
     stats.maxSpeed = 0.0;
     const VecX& v = body.velocities();
     for (size_t i = 0; i < body.vertexCount(); ++i)
@@ -152,13 +234,15 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
     stats.maxStretch = body.maxEdgeStretch();
     stats.kinetic = body.kineticEnergy();
     stats.potential = body.potentialEnergy(mSettings.gravity);
-    stats.elastic = body.elasticEnergy(t0 + dt);
+    stats.elastic = body.elasticEnergy(t1);
 }
 
 // ---- state bytes: "GALESTATE" v1, then per body: name, vertex count, x, v, Δv guess, h guess.
 
 namespace {
-void putU64(std::string& s, uint64_t v) { s.append(reinterpret_cast<const char*>(&v), 8); }
+void putU64(std::string& s, uint64_t v) {
+    s.append(reinterpret_cast<const char*>(&v), 8);
+}
 void putVec(std::string& s, const VecX& v) {
     putU64(s, static_cast<uint64_t>(v.size()));
     if (v.size() > 0) s.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
@@ -184,7 +268,8 @@ struct Reader {
             return VecX();
         }
         VecX v(static_cast<long>(n));
-        if (n > 0) std::memcpy(v.data(), s.data() + pos, sizeof(double) * n); // data() is null when empty
+        if (n > 0)
+            std::memcpy(v.data(), s.data() + pos, sizeof(double) * n); // data() is null when empty
         pos += sizeof(double) * n;
         return v;
     }

@@ -6,6 +6,7 @@
 #include "fields/field.h"
 #include "solver/body.h"
 #include "solver/collider.h"
+#include "solver/self_collision.h"
 
 #include <memory>
 #include <string>
@@ -15,46 +16,51 @@ namespace gale::solver {
 
 struct WorldSettings {
     double fps = 24.0;
-    int substeps = 4;      // per frame, the minimum
-    int maxHalvings = 6;   // a substep may be split down to 1/2⁶ of its size
+    int substeps = 4;    // per frame, the minimum
+    int maxHalvings = 6; // a substep may be split down to 1/2⁶ of its size
     Vec3 gravity = Vec3(0.0, -9.81, 0.0);
-    double airDensity = 1.225; // kg/m³
-    int threads = 1;       // 0: all hardware threads; results do not depend on it
+    double airDensity = 1.225;  // kg/m³
+    int threads = 1;            // 0: all hardware threads; results do not depend on it
     bool noNewtonRetry = false; // tests and benchmarks of the raw halving: no Newton retry
 };
 
 // Per body, per frame.
 struct BodyFrameStats {
     std::string name;
-    int substeps = 0;        // accepted substeps
-    int rejected = 0;        // substeps undone and retried at half the step
-    int recovered = 0;       // substeps at the smallest size recovered by Body::recover
-    int newtonRetries = 0;   // substeps in trouble retried with Newton before halving
-    int deepestHalving = 0;  // 0: every substep at the base size
-    long iterations = 0;     // linear-solver iterations, summed over substeps
-    int maxIterations = 0;   // the most in one substep
+    int substeps = 0;       // accepted substeps
+    int rejected = 0;       // substeps undone and retried at half the step
+    int recovered = 0;      // substeps at the smallest size recovered by Body::recover
+    int newtonRetries = 0;  // substeps in trouble retried with Newton before halving
+    int deepestHalving = 0; // 0: every substep at the base size
+    long iterations = 0;    // linear-solver iterations, summed over substeps
+    int maxIterations = 0;  // the most in one substep
     double maxResidual = 0.0;
     int newtonIterations = 0;       // Newton corrections after the linearised solves, summed
     int maxNewtonIterations = 0;    // the most in one substep
     double maxNewtonResidual = 0.0; // m/s: the largest velocity residual a substep ended with
     int lineSearchCuts = 0;         // Newton line-search halvings, summed
     int newtonStalled = 0;          // substeps that ended above newton_tolerance
-    double maxSpeed = 0.0;   // m/s at the end of the frame
-    double maxStretch = 0.0; // edge length / rest length at the end of the frame
+    double maxSpeed = 0.0;          // m/s at the end of the frame
+    double maxStretch = 0.0;        // edge length / rest length at the end of the frame
     double kinetic = 0.0, elastic = 0.0, potential = 0.0; // J, end of frame
     size_t windNonFinite = 0;
     int clampedJacobians = 0;
-    int contacts = 0;        // vertices touching colliders at the end of the frame
+    int contacts = 0; // vertices touching colliders at the end of the frame
+    // Intersecting triangle pairs with a triangle of this body at the end of the frame, counted
+    // when it takes part in cloth–cloth collision (−1: not counted).
+    int selfIntersections = -1;
     std::vector<std::string> events; // substep halvings and recoveries, with reasons
-    bool failed = false;     // non-finite state that halving could not fix (state restored)
+    bool failed = false;             // non-finite state that halving could not fix (state restored)
 };
 
 struct FrameStats {
     int frame = 0;
-    double time = 0.0;        // seconds at the end of the frame
+    double time = 0.0; // seconds at the end of the frame
     double wallSeconds = 0.0;
     std::vector<BodyFrameStats> bodies;
     bool failed = false;
+    bool selfCollision = false;      // some bodies collide with themselves and each other
+    SelfCollisionStats selfContacts; // ... their passes over the frame
 };
 
 class World {
@@ -81,8 +87,26 @@ public:
     std::string saveState() const;
     bool loadState(const std::string& bytes, std::string& error);
 
+    // Cloth–cloth collision of the bodies with collision().self (null when none has it); set
+    // up on the first advance.
+    const SelfCollision* selfCollision() const { return mSelf.get(); }
+
 private:
+    // Where a body's frame stepping stands: ticks of the finest substep done, halving level,
+    // substep index, stopped by a failure.
+    struct BodyRun {
+        long tick = 0;
+        int level = 0;
+        int index = 0;
+        bool stopped = false;
+    };
     void advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats);
+    // Steps `body` until `run.tick` reaches `untilTick` (ticks: 2^maxHalvings per base substep).
+    void stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
+                  BodyFrameStats& stats);
+    void finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const;
+    void setUpSelfCollision(FrameStats& fs);
+    void advanceColliding(double t0, double dt, int substeps, FrameStats& fs);
 
     WorldSettings mSettings;
     fields::FieldPtr mWind;
@@ -90,6 +114,9 @@ private:
     std::vector<Collider> mColliders;
     struct Arena;
     std::unique_ptr<Arena> mArena;
+    std::unique_ptr<SelfCollision> mSelf;
+    std::vector<size_t> mSelfBodies; // indices of the bodies in mSelf, in its order
+    bool mSelfSetUp = false;
 };
 
 } // namespace gale::solver
