@@ -158,7 +158,8 @@ std::string frameJson(const solver::FrameStats& f) {
         const solver::SelfCollisionStats& s = f.selfContacts;
         o << ", \"self_collision\": {\"passes\": " << s.passes
           << ", \"proximity_pairs\": " << s.proximityPairs << ", \"ccd_hits\": " << s.ccdHits
-          << ", \"ccd_rounds\": " << s.ccdRounds << ", \"fail_safe_runs\": " << s.failSafeRuns
+          << ", \"ccd_rounds\": " << s.ccdRounds << ", \"broad_phases\": " << s.broadPhases
+          << ", \"candidates\": " << s.candidates << ", \"fail_safe_runs\": " << s.failSafeRuns
           << ", \"zone_vertices\": " << s.zoneVertices
           << ", \"frozen_vertices\": " << s.frozenVertices << ", \"unresolved\": " << s.unresolved
           << ", \"start_touching\": " << s.startTouching

@@ -72,6 +72,8 @@ void SelfCollisionStats::add(const SelfCollisionStats& o) {
     proximityPairs += o.proximityPairs;
     ccdHits += o.ccdHits;
     ccdRounds += o.ccdRounds;
+    broadPhases += o.broadPhases;
+    candidates += o.candidates;
     failSafeRuns += o.failSafeRuns;
     zoneVertices += o.zoneVertices;
     frozenVertices += o.frozenVertices;
@@ -266,32 +268,54 @@ void stopApproach(std::vector<double>& v, const std::vector<double>& invMass,
 }
 } // namespace
 
+void SelfCollision::ensureCandidates() {
+    // Valid while no vertex has moved more than δ = ξ/2 from where they were gathered: boxes
+    // inflated by ξ on each side then still cover every pair within ξ (proximity) or whose path
+    // comes within ξ_c ≤ ξ (CCD), since each box has grown by at most δ per side.
+    const double delta = 0.5 * mMaxThickness;
+    if (mCandidatesValid) {
+        double moved2 = 0.0;
+        for (size_t i = 0; i < mX1.size() / 3; ++i)
+            moved2 = std::max(moved2, (Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i)))
+                                          .squaredNorm());
+        if (moved2 <= delta * delta) return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    refitBoxes(true, mMaxThickness);
+    forCandidates(true, mMaxThickness, true, [&](const std::vector<Pair>& c) { mCandVt = c; });
+    forCandidates(true, mMaxThickness, false, [&](const std::vector<Pair>& c) { mCandEe = c; });
+    mXc = mX1;
+    mCandidatesValid = true;
+    ++mStats.broadPhases;
+    mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
+    mStats.broadSeconds += seconds(t0);
+}
+
 int SelfCollision::proximity() {
+    ensureCandidates();
     const bool kinds[2] = {true, false};
     std::vector<Contact> contacts;
     for (bool vt : kinds) {
-        forCandidates(false, 0.5 * mMaxThickness, vt, [&](const std::vector<Pair>& cands) {
-            std::vector<std::vector<Contact>> found(cands.size());
-            tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
-                Pair p = cands[c];
-                double d1 = 0.0, d0 = 0.0;
-                const Vec3 r1 = closestPair(mX1, p, vt, d1);
-                const double xi = pairThickness(p);
-                if (!(d1 < xi) || restClose(p, vt)) return;
-                Pair p0 = p;
-                const Vec3 r0 = closestPair(mX0, p0, vt, d0);
-                Vec3 n;
-                if (d0 > kTouching)
-                    n = r0 / d0;
-                else if (d1 > kTouching)
-                    n = r1 / d1;
-                else
-                    return;
-                found[c].push_back({p, n, xi});
-            });
-            for (auto& f : found)
-                for (auto& c : f) contacts.push_back(c);
+        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        std::vector<uint8_t> state(cands.size(), 0);
+        std::vector<Contact> found(cands.size());
+        tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
+            Pair p = cands[c];
+            double d1 = 0.0, d0 = 0.0;
+            const Vec3 r1 = closestPair(mX1, p, vt, d1);
+            const double xi = pairThickness(p);
+            if (!(d1 < xi) || restClose(p, vt)) return;
+            Pair p0 = p;
+            const Vec3 r0 = closestPair(mX0, p0, vt, d0);
+            Vec3 n;
+            if (d0 > kTouching) n = r0 / d0;
+            else if (d1 > kTouching) n = r1 / d1;
+            else return;
+            found[c] = {p, n, xi};
+            state[c] = 1;
         });
+        for (size_t c = 0; c < cands.size(); ++c)
+            if (state[c]) contacts.push_back(found[c]);
     }
     for (int it = 0; it < mSettings.proximityIterations; ++it)
         for (const Contact& c : contacts) {
@@ -302,75 +326,95 @@ int SelfCollision::proximity() {
     return static_cast<int>(contacts.size());
 }
 
-int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone) {
-    const double reach = mSettings.ccdFraction * mMaxThickness;
-    auto t0 = std::chrono::steady_clock::now();
-    refitBoxes(true, 0.5 * reach);
-    mStats.broadSeconds += seconds(t0);
-    t0 = std::chrono::steady_clock::now();
+int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone,
+                            const std::vector<uint8_t>* dirty) {
+    ensureCandidates();
+    const auto t0 = std::chrono::steady_clock::now();
     ++mStats.ccdRounds;
     std::vector<Contact> found;
     long long touching = 0;
     const bool kinds[2] = {true, false};
     for (bool vt : kinds) {
-        forCandidates(true, 0.5 * reach, vt, [&](const std::vector<Pair>& cands) {
-            std::vector<uint8_t> state(cands.size(), 0); // 1 hit, 2 touching at the start
-            std::vector<Contact> out(cands.size());
-            tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
-                Pair p = cands[c];
-                // Inside one impact zone the motion is affine with no distance shrinking (file
-                // comment): such a pair cannot come closer, so it is not tested.
-                if (zone && (*zone)[p.v[0]] >= 0 && (*zone)[p.v[0]] == (*zone)[p.v[1]] &&
-                    (*zone)[p.v[0]] == (*zone)[p.v[2]] && (*zone)[p.v[0]] == (*zone)[p.v[3]])
-                    return;
-                double d0 = 0.0;
-                closestPair(mX0, p, vt, d0);
-                if (!(d0 > kTouching)) {
-                    state[c] = 2;
-                    return;
-                }
-                const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
-                const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
-                contact::CcdOptions opt;
-                opt.thickness = mSettings.ccdFraction * pairThickness(p);
-                opt.shrinkWithinThickness = true;
-                const double xiUsed = d0 <= opt.thickness ? 0.5 * d0 : opt.thickness;
-                opt.gapTolerance = std::min(1e-6, 0.05 * xiUsed);
-                double toi = 0.0;
-                const bool hit = vt ? contact::vertexTriangleCcd(x0(0), x1(0), x0(1), x1(1), x0(2),
-                                                                 x1(2), x0(3), x1(3), opt, toi)
-                                    : contact::edgeEdgeCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2),
-                                                           x0(3), x1(3), opt, toi);
-                if (!hit) return;
-                // The pair at the time of contact: its closest points and normal.
-                std::vector<double> xt(12);
-                Pair local = p;
-                for (int k = 0; k < 4; ++k) {
-                    local.v[k] = k;
-                    const Vec3 y = x0(k) + toi * (x1(k) - x0(k));
-                    for (int j = 0; j < 3; ++j) xt[3 * k + j] = y[j];
-                }
-                double dt = 0.0;
-                const Vec3 rt = closestPair(xt, local, vt, dt);
-                Vec3 n = dt > kTouching ? Vec3(rt / dt) : Vec3::Zero();
-                if (n.isZero()) {
-                    Pair q = p;
-                    double dd = 0.0;
-                    const Vec3 r0 = closestPair(mX0, q, vt, dd);
-                    n = r0 / dd;
-                }
-                p.a = local.a;
-                // The gap along n at x₀, and the end gap the correction asks for: half-way
-                // between it and the CCD thickness (a margin, so the pair is clear next round).
-                const double g0 = n.dot(relative(mX0, p));
-                state[c] = 1;
-                out[c] = {p, n, 0.5 * (g0 + xiUsed)};
-            });
-            for (size_t c = 0; c < cands.size(); ++c) {
-                if (state[c] == 1) found.push_back(out[c]);
-                if (state[c] == 2) ++touching;
+        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        std::vector<uint8_t> state(cands.size(), 0); // 1 hit, 2 touching at the start
+        std::vector<Contact> out(cands.size());
+        tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
+            Pair p = cands[c];
+            // A pair none of whose vertices moved since a round that found it clear, and that
+            // was not hit then, has the same path: still clear.
+            if (dirty && !(*dirty)[p.v[0]] && !(*dirty)[p.v[1]] && !(*dirty)[p.v[2]] &&
+                !(*dirty)[p.v[3]])
+                return;
+            // Inside one impact zone the motion is affine with no distance shrinking (file
+            // comment): such a pair cannot come closer, so it is not tested.
+            if (zone && (*zone)[p.v[0]] >= 0 && (*zone)[p.v[0]] == (*zone)[p.v[1]] &&
+                (*zone)[p.v[0]] == (*zone)[p.v[2]] && (*zone)[p.v[0]] == (*zone)[p.v[3]])
+                return;
+            const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
+            const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
+            const double xiC = mSettings.ccdFraction * pairThickness(p);
+            double d0 = 0.0;
+            closestPair(mX0, p, vt, d0);
+            if (!(d0 > kTouching)) {
+                state[c] = 2;
+                return;
             }
+            {
+                // Cheap rejection: the distance at x₀ less the largest relative displacement
+                // stays above the CCD thickness (the bound conservative advancement starts from).
+                Vec3 mean = Vec3::Zero();
+                for (int k = 0; k < 4; ++k) mean += x1(k) - x0(k);
+                mean /= 4.0;
+                double la = 0.0, lb = 0.0;
+                for (int k = 0; k < 4; ++k) {
+                    const double l = (x1(k) - x0(k) - mean).norm();
+                    double& side = (vt ? k < 1 : k < 2) ? la : lb;
+                    side = std::max(side, l);
+                }
+                if (d0 - (la + lb) * (1.0 + 1e-12) > xiC) return;
+            }
+            contact::CcdOptions opt;
+            opt.thickness = xiC;
+            opt.shrinkWithinThickness = true;
+            const double xiUsed = d0 <= opt.thickness ? 0.5 * d0 : opt.thickness;
+            opt.gapTolerance = std::min(1e-6, 0.05 * xiUsed);
+            double toi = 0.0;
+            const bool hit =
+                vt ? contact::vertexTriangleCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2), x0(3),
+                                                x1(3), opt, toi)
+                   : contact::edgeEdgeCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2), x0(3), x1(3),
+                                          opt, toi);
+            if (!hit) return;
+            // The pair at the time of contact: its closest points and normal.
+            std::vector<double> xt(12);
+            Pair local = p;
+            for (int k = 0; k < 4; ++k) {
+                local.v[k] = k;
+                const Vec3 y = x0(k) + toi * (x1(k) - x0(k));
+                for (int j = 0; j < 3; ++j) xt[3 * k + j] = y[j];
+            }
+            double dt = 0.0;
+            const Vec3 rt = closestPair(xt, local, vt, dt);
+            Vec3 n;
+            if (dt > kTouching) {
+                n = rt / dt;
+            } else {
+                Pair q = p;
+                double dd = 0.0;
+                const Vec3 r0 = closestPair(mX0, q, vt, dd);
+                n = r0 / dd;
+            }
+            p.a = local.a;
+            // The gap along n at x₀, and the end gap the correction asks for: half-way between
+            // it and the CCD thickness (a margin, so the pair is clear in the next round).
+            const double g0 = n.dot(relative(mX0, p));
+            state[c] = 1;
+            out[c] = {p, n, 0.5 * (g0 + xiUsed)};
         });
+        for (size_t c = 0; c < cands.size(); ++c) {
+            if (state[c] == 1) found.push_back(out[c]);
+            if (state[c] == 2) ++touching;
+        }
     }
     mStats.startTouching = std::max(mStats.startTouching, touching);
     if (apply) {
@@ -381,12 +425,21 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
         }
         mStats.ccdHits += static_cast<long long>(found.size());
     }
-    if (hits) {
-        hits->clear();
-        for (const Contact& c : found) hits->push_back(c.pair);
-    }
+    mLastHits.clear();
+    for (const Contact& c : found) mLastHits.push_back(c.pair);
+    if (hits) *hits = mLastHits;
     mStats.ccdSeconds += seconds(t0);
     return static_cast<int>(found.size());
+}
+
+std::vector<uint8_t> SelfCollision::dirtySince(const std::vector<double>& before) const {
+    // Moved since `before`, or in a pair the last round hit (a hit it did not move stays one).
+    std::vector<uint8_t> d(before.size() / 3, 0);
+    for (size_t k = 0; k < before.size(); ++k)
+        if (before[k] != mX1[k]) d[k / 3] = 1;
+    for (const Pair& p : mLastHits)
+        for (int v : p.v) d[v] = 1;
+    return d;
 }
 
 bool SelfCollision::rigidZone(const std::vector<int>& members) const {
@@ -488,6 +541,7 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
         for (size_t i = 0; i < n; ++i)
             if (inZone[i]) zones[find(static_cast<int>(i))].push_back(static_cast<int>(i));
         std::vector<int> zoneOf(n, -1);
+        const std::vector<double> before = mX1;
         for (const auto& z : zones)
             if (!z.empty()) {
                 applyZone(z);
@@ -495,7 +549,8 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
                 if (rigidZone(z))
                     for (int i : z) zoneOf[i] = z.front();
             }
-        ccdRound(false, &hits, &zoneOf);
+        const std::vector<uint8_t> dirty = dirtySince(before);
+        ccdRound(false, &hits, &zoneOf, &dirty);
     }
     long long zoneCount = 0;
     for (uint8_t z : inZone) zoneCount += z;
@@ -523,20 +578,22 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
         std::copy(start[b].data(), start[b].data() + start[b].size(),
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
+    mCandidatesValid = false;
     auto t0 = std::chrono::steady_clock::now();
-    refitBoxes(false, 0.5 * mMaxThickness);
-    mStats.broadSeconds += seconds(t0);
-    t0 = std::chrono::steady_clock::now();
     mStats.proximityPairs += proximity();
     mStats.proximitySeconds += seconds(t0);
     std::vector<Pair> hits;
     bool clear = false;
-    for (int r = 0; r < mSettings.ccdRounds; ++r)
-        if (ccdRound(true, nullptr) == 0) {
+    std::vector<uint8_t> dirty;
+    for (int r = 0; r < mSettings.ccdRounds; ++r) {
+        const std::vector<double> before = mX1;
+        if (ccdRound(true, nullptr, nullptr, r == 0 ? nullptr : &dirty) == 0) {
             clear = true;
             break;
         }
-    if (!clear && ccdRound(false, &hits) > 0) impactZones(hits);
+        dirty = dirtySince(before);
+    }
+    if (!clear && ccdRound(false, &hits, nullptr, &dirty) > 0) impactZones(hits);
     mStats.passes = 1;
     ++mPasses;
     scatter();
@@ -577,6 +634,7 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.mBuilt = false;
     probe.mStats = SelfCollisionStats();
     probe.refitBoxes(false, 0.5 * radius);
+    probe.mCandidatesValid = false;
     double best = INFINITY;
     const bool kinds[2] = {true, false};
     for (bool vt : kinds)

@@ -20,6 +20,8 @@ struct SelfCollisionStats {
     long long proximityPairs = 0; // pairs found closer than the thickness at x₁
     long long ccdHits = 0;        // CCD hits corrected
     long long ccdRounds = 0;      // CCD detection rounds (≥ 1 per pass)
+    long long broadPhases = 0;     // candidate gatherings (≥ 1 per pass)
+    long long candidates = 0;      // candidate pairs they found, summed
     long long failSafeRuns = 0;   // passes that needed impact zones
     long long zoneVertices = 0;   // vertices moved rigidly by impact zones, summed
     long long frozenVertices = 0; // vertices held at x₀ by the last resort
@@ -82,7 +84,13 @@ private:
     int proximity();
     // One CCD detection over the step (and, with `apply`, the corrections); `zone`: per vertex
     // its rigid impact zone or −1 (pairs inside one zone are skipped).
-    int ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone = nullptr);
+    // `dirty`: per vertex whether it moved since the last round (null: test every candidate).
+    int ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone = nullptr,
+                 const std::vector<uint8_t>* dirty = nullptr);
+    // The pass's candidate pairs (swept boxes inflated by ξ), gathered again only when some
+    // vertex has moved more than ξ/2 since.
+    void ensureCandidates();
+    std::vector<uint8_t> dirtySince(const std::vector<double>& before) const;
     bool rigidZone(const std::vector<int>& members) const;
     void impactZones(std::vector<Pair>& hits);
     void applyZone(const std::vector<int>& members);
@@ -100,6 +108,10 @@ private:
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
     contact::Bvh mTriTree, mEdgeTree;
+    std::vector<Pair> mCandVt, mCandEe;
+    std::vector<double> mXc; // x₁ when the candidates were gathered
+    bool mCandidatesValid = false;
+    std::vector<Pair> mLastHits; // of the last CCD round
     std::vector<contact::Box> mTriBoxes, mEdgeBoxes;
     bool mBuilt = false;
     long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild
