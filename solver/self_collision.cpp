@@ -21,10 +21,12 @@
 #include "solver/contact/intersect.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -37,6 +39,8 @@ namespace {
 constexpr double kTouching = 1e-9; // m: pairs this close at x₀ have no side to keep
 constexpr int kChunk = 64;         // primitives per parallel chunk (results ordered by chunk)
 constexpr int kRebuildEvery = 8;   // passes between tree rebuilds (refits in between)
+// Candidates stay valid while no vertex moves more than this × ξ from where they were gathered.
+constexpr double kMoveAllowance = 0.5;
 
 double seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -133,33 +137,36 @@ void SelfCollision::scatter() {
 }
 
 void SelfCollision::refitBoxes(bool swept, double inflate) {
-    const auto at = [&](const std::vector<double>& x, int v) { return vec3At(x.data(), v); };
+    // Boxes of vertices, triangles and edges over the step (or at x₁), each inflated by
+    // `inflate`: overlapping boxes cover every pair within 2·inflate.
+    const auto boxOf = [&](const int* v, int count) {
+        Box b;
+        for (int k = 0; k < count; ++k) {
+            b.add(Vec3(vec3At(mX1.data(), v[k])));
+            if (swept) b.add(Vec3(vec3At(mX0.data(), v[k])));
+        }
+        b.inflate(inflate);
+        return b;
+    };
+    mVertBoxes.resize(mVertexBody.size());
     mTriBoxes.resize(mTris.size());
     mEdgeBoxes.resize(mEdges.size());
-    for (size_t i = 0; i < mTris.size(); ++i) {
-        Box b;
-        for (int v : mTris[i]) {
-            b.add(Vec3(at(mX1, v)));
-            if (swept) b.add(Vec3(at(mX0, v)));
-        }
-        b.inflate(inflate);
-        mTriBoxes[i] = b;
-    }
-    for (size_t i = 0; i < mEdges.size(); ++i) {
-        Box b;
-        for (int v : mEdges[i]) {
-            b.add(Vec3(at(mX1, v)));
-            if (swept) b.add(Vec3(at(mX0, v)));
-        }
-        b.inflate(inflate);
-        mEdgeBoxes[i] = b;
-    }
+    tbb::parallel_for(size_t(0), mVertBoxes.size(), [&](size_t i) {
+        const int v = static_cast<int>(i);
+        mVertBoxes[i] = boxOf(&v, 1);
+    });
+    tbb::parallel_for(size_t(0), mTris.size(),
+                      [&](size_t i) { mTriBoxes[i] = boxOf(mTris[i].data(), 3); });
+    tbb::parallel_for(size_t(0), mEdges.size(),
+                      [&](size_t i) { mEdgeBoxes[i] = boxOf(mEdges[i].data(), 2); });
     if (!mBuilt || (mPasses % kRebuildEvery == 0 && mBuiltPass != mPasses)) {
-        mTriTree.build(mTriBoxes);
-        mEdgeTree.build(mEdgeBoxes);
+        tbb::parallel_invoke([&] { mVertTree.build(mVertBoxes); },
+                             [&] { mTriTree.build(mTriBoxes); },
+                             [&] { mEdgeTree.build(mEdgeBoxes); });
         mBuilt = true;
         mBuiltPass = mPasses;
     } else {
+        mVertTree.refit(mVertBoxes);
         mTriTree.refit(mTriBoxes);
         mEdgeTree.refit(mEdgeBoxes);
     }
@@ -169,48 +176,51 @@ double SelfCollision::pairThickness(const Pair& p) const {
     return std::max({mThick[p.v[0]], mThick[p.v[1]], mThick[p.v[2]], mThick[p.v[3]]});
 }
 
-// Vertex–triangle pairs (v, a, b, c) and edge–edge pairs (p, q, r, s) whose boxes overlap, the
-// primitives sharing no vertex and not all held; α left to the narrow phase. The trees and the
-// vertex boxes are inflated by half the reach (refitBoxes), so overlapping boxes cover every
-// pair that comes within the reach (over the step when `swept`).
-template <class Fn>
-void SelfCollision::forCandidates(bool swept, double halfReach, bool vertexTriangle, Fn&& fn) {
-    if (vertexTriangle) {
-        const std::vector<Pair> cands =
-            parallelCollect<Pair>(mVertexBody.size(), [&](size_t i, std::vector<Pair>& out) {
-                Box q;
-                q.add(Vec3(vec3At(mX1.data(), i)));
-                if (swept) q.add(Vec3(vec3At(mX0.data(), i)));
-                q.inflate(halfReach);
-                const int vi = static_cast<int>(i);
-                mTriTree.query(q, [&](int t) {
-                    const auto& tri = mTris[t];
-                    if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
-                    if (mInvMass[vi] == 0.0 && mInvMass[tri[0]] == 0.0 && mInvMass[tri[1]] == 0.0 &&
-                        mInvMass[tri[2]] == 0.0)
-                        return; // nothing can move
-                    out.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
-                });
+// Vertex–triangle pairs (v, a, b, c) and edge–edge pairs (p, q, r, s) whose boxes (refitBoxes)
+// overlap, the primitives sharing no vertex and not all held; α left to the narrow phase. One
+// simultaneous descent of two trees each (bvh.h), the two kinds side by side; the order of the
+// pairs depends only on the trees.
+void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>& eeOut) const {
+    const auto held = [&](int a, int b, int c, int d) {
+        return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
+    };
+    tbb::parallel_invoke(
+        [&] {
+            vtOut.clear();
+            mVertTree.overlappingPairs(mTriTree, [&](int vi, int t) {
+                const auto& tri = mTris[t];
+                if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
+                if (held(vi, tri[0], tri[1], tri[2])) return; // nothing can move
+                vtOut.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
             });
-        fn(cands);
-    } else {
-        const std::vector<Pair> cands =
-            parallelCollect<Pair>(mEdges.size(), [&](size_t e, std::vector<Pair>& out) {
+        },
+        [&] {
+            eeOut.clear();
+            mEdgeTree.overlappingPairs(mEdgeTree, [&](int e, int f) {
                 const auto& ea = mEdges[e];
-                const Box& q = mEdgeBoxes[e];
-                mEdgeTree.query(q, [&](int f) {
-                    if (f <= static_cast<int>(e)) return;
-                    const auto& eb = mEdges[f];
-                    if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1])
-                        return;
-                    if (mInvMass[ea[0]] == 0.0 && mInvMass[ea[1]] == 0.0 &&
-                        mInvMass[eb[0]] == 0.0 && mInvMass[eb[1]] == 0.0)
-                        return;
-                    out.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
-                });
+                const auto& eb = mEdges[f];
+                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
+                if (held(ea[0], ea[1], eb[0], eb[1])) return;
+                eeOut.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
             });
-        fn(cands);
+        });
+}
+
+double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) const {
+    // l = max over the first primitive's corners of |Δx − m| + the same over the second's, m the
+    // mean displacement: a bound on how much the distance can change over the step (ACCD, §4).
+    Vec3 d[4], mean = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) {
+        d[k] = Vec3(vec3At(mX1.data(), p.v[k])) - Vec3(vec3At(mX0.data(), p.v[k]));
+        mean += d[k];
     }
+    mean /= 4.0;
+    double la = 0.0, lb = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        double& side = (vertexTriangle ? k < 1 : k < 2) ? la : lb;
+        side = std::max(side, (d[k] - mean).norm());
+    }
+    return (la + lb) * (1.0 + 1e-12);
 }
 
 bool SelfCollision::restClose(const Pair& p, bool vertexTriangle) const {
@@ -268,55 +278,63 @@ void stopApproach(std::vector<double>& v, const std::vector<double>& invMass,
 }
 } // namespace
 
-void SelfCollision::ensureCandidates() {
+bool SelfCollision::ensureCandidates() {
     // Valid while no vertex has moved more than δ = ξ/2 from where they were gathered: boxes
     // inflated by ξ on each side then still cover every pair within ξ (proximity) or whose path
     // comes within ξ_c ≤ ξ (CCD), since each box has grown by at most δ per side.
-    const double delta = 0.5 * mMaxThickness;
+    const double delta = kMoveAllowance * mMaxThickness;
     if (mCandidatesValid) {
         double moved2 = 0.0;
         for (size_t i = 0; i < mX1.size() / 3; ++i)
-            moved2 = std::max(moved2, (Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i)))
-                                          .squaredNorm());
-        if (moved2 <= delta * delta) return;
+            moved2 = std::max(
+                moved2, (Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i))).squaredNorm());
+        if (moved2 <= delta * delta) return false;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    refitBoxes(true, mMaxThickness);
-    forCandidates(true, mMaxThickness, true, [&](const std::vector<Pair>& c) { mCandVt = c; });
-    forCandidates(true, mMaxThickness, false, [&](const std::vector<Pair>& c) { mCandEe = c; });
+    refitBoxes(true, (0.5 + kMoveAllowance) * mMaxThickness);
+    gatherCandidates(mCandVt, mCandEe);
     mXc = mX1;
     mCandidatesValid = true;
+    mMaybeValid = false;
     ++mStats.broadPhases;
     mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
     mStats.broadSeconds += seconds(t0);
+    return true;
 }
 
 int SelfCollision::proximity() {
     ensureCandidates();
-    const bool kinds[2] = {true, false};
     std::vector<Contact> contacts;
-    for (bool vt : kinds) {
+    for (int kind = 0; kind < 2; ++kind) {
+        const bool vt = kind == 0;
         const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
-        std::vector<uint8_t> state(cands.size(), 0);
-        std::vector<Contact> found(cands.size());
-        tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
-            Pair p = cands[c];
-            double d1 = 0.0, d0 = 0.0;
-            const Vec3 r1 = closestPair(mX1, p, vt, d1);
-            const double xi = pairThickness(p);
-            if (!(d1 < xi) || restClose(p, vt)) return;
-            Pair p0 = p;
-            const Vec3 r0 = closestPair(mX0, p0, vt, d0);
-            Vec3 n;
-            if (d0 > kTouching) n = r0 / d0;
-            else if (d1 > kTouching) n = r1 / d1;
-            else return;
-            found[c] = {p, n, xi};
-            state[c] = 1;
-        });
-        for (size_t c = 0; c < cands.size(); ++c)
-            if (state[c]) contacts.push_back(found[c]);
+        // Also which pairs CCD must test (the first round adds those proximity moves): the
+        // distance is Lipschitz in t with the relative displacement bound l, so d(t) ≥ d₁ − l
+        // and a pair with d₁ − l > ξ_c cannot come within ξ_c during the step.
+        std::vector<uint8_t>& maybe = mMaybe[kind];
+        maybe.assign(cands.size(), 0);
+        std::vector<Contact> found =
+            parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& out) {
+                Pair p = cands[c];
+                double d1 = 0.0, d0 = 0.0;
+                const Vec3 r1 = closestPair(mX1, p, vt, d1);
+                const double xi = pairThickness(p);
+                if (!(d1 - relativeMotionBound(p, vt) > mSettings.ccdFraction * xi)) maybe[c] = 1;
+                if (!(d1 < xi) || restClose(p, vt)) return;
+                Pair p0 = p;
+                const Vec3 r0 = closestPair(mX0, p0, vt, d0);
+                Vec3 n;
+                if (d0 > kTouching)
+                    n = r0 / d0;
+                else if (d1 > kTouching)
+                    n = r1 / d1;
+                else
+                    return;
+                out.push_back({p, n, xi});
+            });
+        contacts.insert(contacts.end(), found.begin(), found.end());
     }
+    mMaybeValid = true;
     for (int it = 0; it < mSettings.proximityIterations; ++it)
         for (const Contact& c : contacts) {
             const double g = c.n.dot(relative(mX1, c.pair));
@@ -328,95 +346,79 @@ int SelfCollision::proximity() {
 
 int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone,
                             const std::vector<uint8_t>* dirty) {
-    ensureCandidates();
+    if (ensureCandidates()) dirty = nullptr; // new candidates: no earlier round covered them
     const auto t0 = std::chrono::steady_clock::now();
     ++mStats.ccdRounds;
     std::vector<Contact> found;
-    long long touching = 0;
-    const bool kinds[2] = {true, false};
-    for (bool vt : kinds) {
+    std::atomic<long long> touching{0};
+    for (int kind = 0; kind < 2; ++kind) {
+        const bool vt = kind == 0;
         const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
-        std::vector<uint8_t> state(cands.size(), 0); // 1 hit, 2 touching at the start
-        std::vector<Contact> out(cands.size());
-        tbb::parallel_for(size_t(0), cands.size(), [&](size_t c) {
-            Pair p = cands[c];
-            // A pair none of whose vertices moved since a round that found it clear, and that
-            // was not hit then, has the same path: still clear.
-            if (dirty && !(*dirty)[p.v[0]] && !(*dirty)[p.v[1]] && !(*dirty)[p.v[2]] &&
-                !(*dirty)[p.v[3]])
-                return;
-            // Inside one impact zone the motion is affine with no distance shrinking (file
-            // comment): such a pair cannot come closer, so it is not tested.
-            if (zone && (*zone)[p.v[0]] >= 0 && (*zone)[p.v[0]] == (*zone)[p.v[1]] &&
-                (*zone)[p.v[0]] == (*zone)[p.v[2]] && (*zone)[p.v[0]] == (*zone)[p.v[3]])
-                return;
-            const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
-            const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
-            const double xiC = mSettings.ccdFraction * pairThickness(p);
-            double d0 = 0.0;
-            closestPair(mX0, p, vt, d0);
-            if (!(d0 > kTouching)) {
-                state[c] = 2;
-                return;
-            }
-            {
-                // Cheap rejection: the distance at x₀ less the largest relative displacement
-                // stays above the CCD thickness (the bound conservative advancement starts from).
-                Vec3 mean = Vec3::Zero();
-                for (int k = 0; k < 4; ++k) mean += x1(k) - x0(k);
-                mean /= 4.0;
-                double la = 0.0, lb = 0.0;
-                for (int k = 0; k < 4; ++k) {
-                    const double l = (x1(k) - x0(k) - mean).norm();
-                    double& side = (vt ? k < 1 : k < 2) ? la : lb;
-                    side = std::max(side, l);
+        const std::vector<uint8_t>* maybe = dirty && mMaybeValid ? &mMaybe[vt ? 0 : 1] : nullptr;
+        std::vector<Contact> out =
+            parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& hitsOut) {
+                Pair p = cands[c];
+                // A pair none of whose vertices moved since a round that found it clear, and that
+                // was not hit then, has the same path: still clear.
+                if (dirty && !(maybe && (*maybe)[c]) && !(*dirty)[p.v[0]] && !(*dirty)[p.v[1]] &&
+                    !(*dirty)[p.v[2]] && !(*dirty)[p.v[3]])
+                    return;
+                // Inside one impact zone the motion is affine with no distance shrinking (file
+                // comment): such a pair cannot come closer, so it is not tested.
+                if (zone && (*zone)[p.v[0]] >= 0 && (*zone)[p.v[0]] == (*zone)[p.v[1]] &&
+                    (*zone)[p.v[0]] == (*zone)[p.v[2]] && (*zone)[p.v[0]] == (*zone)[p.v[3]])
+                    return;
+                const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
+                const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
+                const double xiC = mSettings.ccdFraction * pairThickness(p);
+                double d0 = 0.0;
+                closestPair(mX0, p, vt, d0);
+                if (!(d0 > kTouching)) {
+                    ++touching;
+                    return;
                 }
-                if (d0 - (la + lb) * (1.0 + 1e-12) > xiC) return;
-            }
-            contact::CcdOptions opt;
-            opt.thickness = xiC;
-            opt.shrinkWithinThickness = true;
-            const double xiUsed = d0 <= opt.thickness ? 0.5 * d0 : opt.thickness;
-            opt.gapTolerance = std::min(1e-6, 0.05 * xiUsed);
-            double toi = 0.0;
-            const bool hit =
-                vt ? contact::vertexTriangleCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2), x0(3),
-                                                x1(3), opt, toi)
-                   : contact::edgeEdgeCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2), x0(3), x1(3),
-                                          opt, toi);
-            if (!hit) return;
-            // The pair at the time of contact: its closest points and normal.
-            std::vector<double> xt(12);
-            Pair local = p;
-            for (int k = 0; k < 4; ++k) {
-                local.v[k] = k;
-                const Vec3 y = x0(k) + toi * (x1(k) - x0(k));
-                for (int j = 0; j < 3; ++j) xt[3 * k + j] = y[j];
-            }
-            double dt = 0.0;
-            const Vec3 rt = closestPair(xt, local, vt, dt);
-            Vec3 n;
-            if (dt > kTouching) {
-                n = rt / dt;
-            } else {
-                Pair q = p;
-                double dd = 0.0;
-                const Vec3 r0 = closestPair(mX0, q, vt, dd);
-                n = r0 / dd;
-            }
-            p.a = local.a;
-            // The gap along n at x₀, and the end gap the correction asks for: half-way between
-            // it and the CCD thickness (a margin, so the pair is clear in the next round).
-            const double g0 = n.dot(relative(mX0, p));
-            state[c] = 1;
-            out[c] = {p, n, 0.5 * (g0 + xiUsed)};
-        });
-        for (size_t c = 0; c < cands.size(); ++c) {
-            if (state[c] == 1) found.push_back(out[c]);
-            if (state[c] == 2) ++touching;
-        }
+                // Cheap rejection: the distance at x₀ less the largest relative displacement stays
+                // above the CCD thickness (the bound conservative advancement starts from).
+                if (d0 - relativeMotionBound(p, vt) > xiC) return;
+                contact::CcdOptions opt;
+                opt.thickness = xiC;
+                opt.shrinkWithinThickness = true;
+                const double xiUsed = d0 <= opt.thickness ? 0.5 * d0 : opt.thickness;
+                opt.gapTolerance = std::min(1e-6, 0.05 * xiUsed);
+                double toi = 0.0;
+                const bool hit = vt ? contact::vertexTriangleCcd(x0(0), x1(0), x0(1), x1(1), x0(2),
+                                                                 x1(2), x0(3), x1(3), opt, toi)
+                                    : contact::edgeEdgeCcd(x0(0), x1(0), x0(1), x1(1), x0(2), x1(2),
+                                                           x0(3), x1(3), opt, toi);
+                if (!hit) return;
+                // The pair at the time of contact: its closest points and normal.
+                std::vector<double> xt(12);
+                Pair local = p;
+                for (int k = 0; k < 4; ++k) {
+                    local.v[k] = k;
+                    const Vec3 y = x0(k) + toi * (x1(k) - x0(k));
+                    for (int j = 0; j < 3; ++j) xt[3 * k + j] = y[j];
+                }
+                double dt = 0.0;
+                const Vec3 rt = closestPair(xt, local, vt, dt);
+                Vec3 n;
+                if (dt > kTouching) {
+                    n = rt / dt;
+                } else {
+                    Pair q = p;
+                    double dd = 0.0;
+                    const Vec3 r0 = closestPair(mX0, q, vt, dd);
+                    n = r0 / dd;
+                }
+                p.a = local.a;
+                // The gap along n at x₀, and the end gap the correction asks for: half-way between
+                // it and the CCD thickness (a margin, so the pair is clear in the next round).
+                const double g0 = n.dot(relative(mX0, p));
+                hitsOut.push_back({p, n, 0.5 * (g0 + xiUsed)});
+            });
+        found.insert(found.end(), out.begin(), out.end());
     }
-    mStats.startTouching = std::max(mStats.startTouching, touching);
+    mStats.startTouching = std::max(mStats.startTouching, touching.load());
     if (apply) {
         for (const Contact& c : found) {
             const double g1 = c.n.dot(relative(mX1, c.pair));
@@ -579,20 +581,24 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
     mCandidatesValid = false;
+    mLastHits.clear();
     auto t0 = std::chrono::steady_clock::now();
+    std::vector<double> before = mX1;
     mStats.proximityPairs += proximity();
     mStats.proximitySeconds += seconds(t0);
     std::vector<Pair> hits;
     bool clear = false;
-    std::vector<uint8_t> dirty;
+    // The first round: the pairs proximity could not rule out, and those it moved.
+    std::vector<uint8_t> dirty = dirtySince(before);
     for (int r = 0; r < mSettings.ccdRounds; ++r) {
-        const std::vector<double> before = mX1;
-        if (ccdRound(true, nullptr, nullptr, r == 0 ? nullptr : &dirty) == 0) {
+        before = mX1;
+        if (ccdRound(true, nullptr, nullptr, &dirty) == 0) {
             clear = true;
             break;
         }
         dirty = dirtySince(before);
     }
+    mMaybeValid = false;
     if (!clear && ccdRound(false, &hits, nullptr, &dirty) > 0) impactZones(hits);
     mStats.passes = 1;
     ++mPasses;
@@ -636,15 +642,14 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.refitBoxes(false, 0.5 * radius);
     probe.mCandidatesValid = false;
     double best = INFINITY;
-    const bool kinds[2] = {true, false};
-    for (bool vt : kinds)
-        probe.forCandidates(false, 0.5 * radius, vt, [&](const std::vector<Pair>& cands) {
-            for (Pair p : cands) {
-                double d = 0.0;
-                closestPair(probe.mX1, p, vt, d);
-                if (d < best && !probe.restClose(p, vt)) best = d;
-            }
-        });
+    std::vector<Pair> cands[2];
+    probe.gatherCandidates(cands[0], cands[1]);
+    for (int kind = 0; kind < 2; ++kind)
+        for (Pair p : cands[kind]) {
+            double d = 0.0;
+            closestPair(probe.mX1, p, kind == 0, d);
+            if (d < best && !probe.restClose(p, kind == 0)) best = d;
+        }
     return best;
 }
 

@@ -20,8 +20,8 @@ struct SelfCollisionStats {
     long long proximityPairs = 0; // pairs found closer than the thickness at x₁
     long long ccdHits = 0;        // CCD hits corrected
     long long ccdRounds = 0;      // CCD detection rounds (≥ 1 per pass)
-    long long broadPhases = 0;     // candidate gatherings (≥ 1 per pass)
-    long long candidates = 0;      // candidate pairs they found, summed
+    long long broadPhases = 0;    // candidate gatherings (≥ 1 per pass)
+    long long candidates = 0;     // candidate pairs they found, summed
     long long failSafeRuns = 0;   // passes that needed impact zones
     long long zoneVertices = 0;   // vertices moved rigidly by impact zones, summed
     long long frozenVertices = 0; // vertices held at x₀ by the last resort
@@ -78,9 +78,9 @@ private:
     void gather();
     void scatter();
     void refitBoxes(bool swept, double inflate);
-    template <class Fn>
-    void forCandidates(bool swept, double halfReach, bool vertexTriangle, Fn&& fn);
+    void gatherCandidates(std::vector<Pair>& vt, std::vector<Pair>& ee) const;
     bool restClose(const Pair& p, bool vertexTriangle) const;
+    double relativeMotionBound(const Pair& p, bool vertexTriangle) const;
     int proximity();
     // One CCD detection over the step (and, with `apply`, the corrections); `zone`: per vertex
     // its rigid impact zone or −1 (pairs inside one zone are skipped).
@@ -89,7 +89,7 @@ private:
                  const std::vector<uint8_t>* dirty = nullptr);
     // The pass's candidate pairs (swept boxes inflated by ξ), gathered again only when some
     // vertex has moved more than ξ/2 since.
-    void ensureCandidates();
+    bool ensureCandidates(); // true when it gathered them again
     std::vector<uint8_t> dirtySince(const std::vector<double>& before) const;
     bool rigidZone(const std::vector<int>& members) const;
     void impactZones(std::vector<Pair>& hits);
@@ -107,12 +107,16 @@ private:
     std::vector<int> mTriBody;
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
-    contact::Bvh mTriTree, mEdgeTree;
+    contact::Bvh mVertTree, mTriTree, mEdgeTree;
     std::vector<Pair> mCandVt, mCandEe;
     std::vector<double> mXc; // x₁ when the candidates were gathered
     bool mCandidatesValid = false;
+    // Per candidate (vertex–triangle, edge–edge): CCD cannot rule it out from the proximity
+    // pass's distances (the first CCD round tests these and pairs with moved vertices).
+    std::vector<uint8_t> mMaybe[2];
+    bool mMaybeValid = false;
     std::vector<Pair> mLastHits; // of the last CCD round
-    std::vector<contact::Box> mTriBoxes, mEdgeBoxes;
+    std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     bool mBuilt = false;
     long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild
     double mMaxThickness = 0.0;

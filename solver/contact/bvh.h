@@ -40,6 +40,11 @@ public:
     void refit(const std::vector<Box>& boxes);
     // Calls fn(primitive) for every primitive whose box overlaps `q`; returns the nodes visited.
     std::size_t query(const Box& q, const std::function<void(int)>& fn) const;
+    // Calls fn(a, b) for every primitive a of this tree and b of `other` whose boxes overlap, by
+    // one simultaneous descent of both trees (cheaper than a query per primitive when most of
+    // them have neighbours). With other == *this, each unordered pair a ≠ b comes once.
+    template <class Fn>
+    void overlappingPairs(const Bvh& other, Fn&& fn) const;
     std::size_t nodeCount() const { return mNodes.size(); }
     std::size_t primitiveCount() const { return mOrder.size(); }
     const Box& rootBox() const { return mNodes.front().box; }
@@ -56,5 +61,49 @@ private:
     std::vector<int> mOrder;
     std::vector<Box> mBoxes; // per primitive, as last built or refitted
 };
+
+template <class Fn>
+void Bvh::overlappingPairs(const Bvh& other, Fn&& fn) const {
+    if (mOrder.empty() || other.mOrder.empty()) return;
+    const bool self = &other == this;
+    struct Task {
+        int a, b;
+    };
+    std::vector<Task> stack;
+    stack.push_back({0, 0});
+    while (!stack.empty()) {
+        const Task t = stack.back();
+        stack.pop_back();
+        const Node& na = mNodes[t.a];
+        const Node& nb = other.mNodes[t.b];
+        if (!na.box.overlaps(nb.box)) continue;
+        const bool leafA = na.left < 0, leafB = nb.left < 0;
+        if (self && t.a == t.b) {
+            if (leafA) {
+                for (int i = na.begin; i < na.end; ++i)
+                    for (int j = i + 1; j < na.end; ++j)
+                        if (mBoxes[mOrder[i]].overlaps(mBoxes[mOrder[j]])) fn(mOrder[i], mOrder[j]);
+            } else {
+                stack.push_back({na.left, na.left});
+                stack.push_back({na.right, na.right});
+                stack.push_back({na.left, na.right});
+            }
+            continue;
+        }
+        if (leafA && leafB) {
+            for (int i = na.begin; i < na.end; ++i)
+                for (int j = nb.begin; j < nb.end; ++j)
+                    if (mBoxes[mOrder[i]].overlaps(other.mBoxes[other.mOrder[j]]))
+                        fn(mOrder[i], other.mOrder[j]);
+        } else if (leafB ||
+                   (!leafA && (na.box.hi - na.box.lo).sum() >= (nb.box.hi - nb.box.lo).sum())) {
+            stack.push_back({na.left, t.b});
+            stack.push_back({na.right, t.b});
+        } else {
+            stack.push_back({t.a, nb.left});
+            stack.push_back({t.a, nb.right});
+        }
+    }
+}
 
 } // namespace gale::solver::contact
