@@ -17,6 +17,10 @@ namespace gale::solver {
 namespace {
 // Newton iterations of the retry of a substep in trouble (World::advanceBody).
 constexpr int kRetryNewtonIterations = 16;
+// A self-collision pass that leaves an edge longer than kPassStretch × its rest length and
+// kPassStretchGrowth × what the solve left has its interval redone at half the step.
+constexpr double kPassStretch = 1.2;
+constexpr double kPassStretchGrowth = 1.1;
 } // namespace
 
 struct World::Arena {
@@ -102,8 +106,8 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
     char buf[320];
     // Collisions resolved at the end of a substep move positions without the implicit solve
     // seeing it: a fast impact at a long substep then stretches cloth (stored energy the contact
-    // never had). When a pass stretches an edge beyond both 1.1 and 1.05 × what the solve left
-    // (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
+    // never had). When a pass stretches an edge beyond both kPassStretch and kPassStretchGrowth
+    // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
     // step, as the solver halves a substep in trouble; the level holds for the rest of the frame.
     int level = 0;
     long tick = 0;
@@ -127,7 +131,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             Body& body = *mBodies[mSelfBodies[k]];
             const double after = body.maxEdgeStretch();
             worst = std::max(worst, after);
-            if ((after > 1.1 && after > 1.05 * stretchBefore[k]) ||
+            if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
                 after > body.limits().overStretch)
                 stretched = true;
         }
