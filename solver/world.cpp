@@ -19,8 +19,8 @@ namespace {
 constexpr int kRetryNewtonIterations = 16;
 // A self-collision pass that leaves an edge longer than kPassStretch × its rest length and
 // kPassStretchGrowth × what the solve left has its interval redone at half the step.
-constexpr double kPassStretch = 1.2;
-constexpr double kPassStretchGrowth = 1.1;
+constexpr double kPassStretch = 1.1;
+constexpr double kPassStretchGrowth = 1.05;
 } // namespace
 
 struct World::Arena {
