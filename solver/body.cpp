@@ -36,11 +36,16 @@ bool PaintedParam::alwaysZero() const {
 
 const char* troubleName(Trouble t) {
     switch (t) {
-    case Trouble::None: return "none";
-    case Trouble::NonFinite: return "non-finite state";
-    case Trouble::SolverNotConverged: return "linear solver did not converge";
-    case Trouble::OverStretch: return "over-stretch";
-    case Trouble::VelocityJump: return "velocity jump";
+    case Trouble::None:
+        return "none";
+    case Trouble::NonFinite:
+        return "non-finite state";
+    case Trouble::SolverNotConverged:
+        return "linear solver did not converge";
+    case Trouble::OverStretch:
+        return "over-stretch";
+    case Trouble::VelocityJump:
+        return "velocity jump";
     }
     return "?";
 }
@@ -63,7 +68,8 @@ void Body::finishSetup(const std::vector<std::array<int, 2>>& edges) {
     mEdges = edges;
     mEdgeRest.resize(edges.size());
     for (size_t e = 0; e < edges.size(); ++e)
-        mEdgeRest[e] = (vec3At(mRest.data(), edges[e][1]) - vec3At(mRest.data(), edges[e][0])).norm();
+        mEdgeRest[e] =
+            (vec3At(mRest.data(), edges[e][1]) - vec3At(mRest.data(), edges[e][0])).norm();
     mContactImpulse.assign(n, 0.0);
     mContactCollider.assign(n, -1);
 }
@@ -77,7 +83,8 @@ void Body::addPins(const PinSet& pins) {
         mPinned.push_back(v);
         mPinSet.push_back(set);
         mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
-                                  ? std::make_shared<const SurfaceBinding>(bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                  ? std::make_shared<const SurfaceBinding>(
+                                        bindToSurface(*pins.attach, vec3At(mX.data(), v)))
                                   : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
@@ -103,8 +110,10 @@ Vec3 Body::pinTarget(size_t k, double t) const {
     const PinSet& set = mPinSets[mPinSet[k]];
     if (mPinBinding[k]) return boundPosition(*set.attach, *mPinBinding[k], t);
     const Vec3 anchor = mAnchor.segment<3>(3 * k);
-    const Vec3 rotated = set.rotate.active ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
-                                           : anchor;
+    const Vec3 rotated =
+        set.rotate.active
+            ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
+            : anchor;
     return rotated + translationAt(set.translate, t);
 }
 
@@ -155,13 +164,16 @@ double Body::elasticEnergy(double t) {
     return out.elasticEnergy;
 }
 
-double Body::maxEdgeStretch() const { return maxEdgeStretchOf(mX); }
+double Body::maxEdgeStretch() const {
+    return maxEdgeStretchOf(mX);
+}
 
 double Body::maxEdgeStretchOf(const VecX& x) const {
     double m = 0.0;
     for (size_t e = 0; e < mEdges.size(); ++e) {
         if (!(mEdgeRest[e] > 0.0)) continue;
-        const double r = (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
+        const double r =
+            (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
         if (std::isnan(r)) return r; // a non-finite state is never "not stretched"
         m = std::max(m, r);
     }
@@ -224,7 +236,10 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
 }
 
 int Body::resolveContacts(const Environment& env, double t1, double h) {
-    if (!env.colliders || env.colliders->empty()) return 0;
+    if (!env.colliders || env.colliders->empty()) {
+        mTouching.clear();
+        return 0;
+    }
     const size_t n = vertexCount();
     std::vector<uint8_t> touched(n, 0);
     for (const Collider& c : *env.colliders) {
@@ -267,6 +282,7 @@ int Body::resolveContacts(const Environment& env, double t1, double h) {
     }
     int count = 0;
     for (uint8_t u : touched) count += u;
+    mTouching = std::move(touched);
     return count;
 }
 
@@ -324,8 +340,8 @@ double Body::aeroQuadratic(const VecX& x) const {
 // moderate. Started from the symmetric solution; if it does not reach the tolerance the step
 // keeps the symmetric solve (the skew part explicit, as it was before) and counts a fallback.
 SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
-    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver, mOptions.cgTolerance,
-                                   mOptions.cgMaxIterations);
+    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver,
+                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
     if (!(mSkewed || mAeroPosition) || !ls.converged || ls.failed) return ls;
     const long n3 = b.size();
     const auto dot = [&](const VecX& u, const VecX& w) {
@@ -373,8 +389,8 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
         int k = 0;
         for (int j = 0; j < kGmresRestart; ++j) {
             Z[j].setZero(n3);
-            const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver, precTolerance,
-                                                 mOptions.cgMaxIterations);
+            const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver,
+                                                 precTolerance, mOptions.cgMaxIterations);
             ls.iterations += ps.iterations;
             if (ps.failed || !Z[j].allFinite()) {
                 failed = true;
@@ -628,7 +644,8 @@ int Body::recover(const Snapshot& start, double h) {
         if (fixed[i]) continue;
         Eigen::Map<Vec3> v(mV.data() + 3 * i);
         const double speed = v.norm();
-        if (!(speed <= mRecoverySpeed)) v = std::isfinite(speed) ? Vec3((mRecoverySpeed / speed) * v) : Vec3::Zero();
+        if (!(speed <= mRecoverySpeed))
+            v = std::isfinite(speed) ? Vec3((mRecoverySpeed / speed) * v) : Vec3::Zero();
     }
     for (size_t i = 0; i < n; ++i)
         if (!fixed[i]) mX.segment<3>(3 * i) = x0.segment<3>(3 * i) + h * mV.segment<3>(3 * i);
@@ -687,10 +704,11 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
                 }
             st.windNonFinite = std::max(ss.nonFinite, bad);
             if (!ss.ok || st.windNonFinite) {
-                st.windMessage = ss.message.empty()
-                                     ? std::to_string(st.windNonFinite) +
-                                           " wind sample(s) were not finite and were replaced by zero"
-                                     : ss.message;
+                st.windMessage =
+                    ss.message.empty()
+                        ? std::to_string(st.windNonFinite) +
+                              " wind sample(s) were not finite and were replaced by zero"
+                        : ss.message;
                 if (st.windNonFinite == 0 && !ss.ok) st.windNonFinite = 1;
             }
         }
@@ -745,13 +763,13 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         }
         ls.converged = true;
     } else {
-    if (mOptions.warmStart && mDvGuess.size() == static_cast<long>(3 * n) && mHGuess > 0.0 &&
-        mDvGuess.allFinite())
-        mDv = mDvGuess * (h / mHGuess);
-    else
-        mDv.setZero(3 * n);
-    mSolver.setPreconditioner(mOptions.preconditioner);
-    ls = solveLinear(mB, mDv);
+        if (mOptions.warmStart && mDvGuess.size() == static_cast<long>(3 * n) && mHGuess > 0.0 &&
+            mDvGuess.allFinite())
+            mDv = mDvGuess * (h / mHGuess);
+        else
+            mDv.setZero(3 * n);
+        mSolver.setPreconditioner(mOptions.preconditioner);
+        ls = solveLinear(mB, mDv);
     }
     st.iterations = ls.iterations;
     st.residual = ls.residual;
@@ -810,8 +828,9 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         const double limit = mRecoverySpeed;
         if (maxJump > limit) {
             st.trouble = Trouble::VelocityJump;
-            std::snprintf(buf, sizeof buf, "a vertex changed speed by %.3g m/s in one substep "
-                                           "(limit %.3g m/s)",
+            std::snprintf(buf, sizeof buf,
+                          "a vertex changed speed by %.3g m/s in one substep "
+                          "(limit %.3g m/s)",
                           maxJump, limit);
             st.reason = buf;
         }

@@ -57,8 +57,9 @@ struct PinSet {
 struct StepOptions {
     AeroJacobian aeroJacobian = AeroJacobian::Projected;
     LinearSolverKind linearSolver = LinearSolverKind::Pcg;
-    Preconditioner preconditioner = Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
-    double cgTolerance = 1e-3;  // relative residual of the filtered system
+    Preconditioner preconditioner =
+        Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
+    double cgTolerance = 1e-3;     // relative residual of the filtered system
     int cgMaxIterations = 2000;
     // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):
     // at most `newtonIterations` corrections, until every free vertex's velocity residual
@@ -70,7 +71,7 @@ struct StepOptions {
     // with each triangle (∂F/∂x) and the parts of ∂F/∂v the symmetric damping drops, by GMRES.
     // Off: the SPD linearisation of every iterate (cheaper; no quadratic convergence).
     bool newtonFullJacobian = true;
-    bool warmStart = true;      // start CG from the previous substep's Δv
+    bool warmStart = true; // start CG from the previous substep's Δv
     // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
     // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
     bool explicitEuler = false;
@@ -103,15 +104,15 @@ const char* troubleName(Trouble t);
 
 struct SubstepStatus {
     Trouble trouble = Trouble::None;
-    std::string reason;       // human-readable detail of the trouble
-    int iterations = 0;       // linear-solver iterations (all Newton iterations)
-    double residual = 0.0;    // the largest relative residual of those solves
+    std::string reason;    // human-readable detail of the trouble
+    int iterations = 0;    // linear-solver iterations (all Newton iterations)
+    double residual = 0.0; // the largest relative residual of those solves
     bool converged = true;
     int newtonIterations = 0;    // Newton corrections after the linearised solve
     double newtonResidual = 0.0; // m/s: the largest free vertex's velocity residual at the end
     int lineSearchCuts = 0;      // step halvings of the Newton line search
     bool newtonStalled = false;  // stopped above the tolerance: no step lowered the merit
-    size_t windNonFinite = 0; // wind samples that came back NaN/inf (replaced by zero)
+    size_t windNonFinite = 0;    // wind samples that came back NaN/inf (replaced by zero)
     std::string windMessage;
     int clampedJacobians = 0; // paper Jacobian with C_D < C_L, clamped
     double maxSpeed = 0.0;    // m/s after the step
@@ -192,6 +193,8 @@ public:
     // The triangles cloth–cloth contact sees (null: a body without a surface, e.g. hair).
     virtual const std::vector<std::array<int, 3>>* collisionTriangles() const { return nullptr; }
     const VecX& restPositions() const { return mRest; } // 3 per vertex (m)
+    // Per vertex: touching a collider after the last substep (empty: no colliders).
+    const std::vector<uint8_t>& colliderContacts() const { return mTouching; }
 
     void addPins(const PinSet& pins);
     const std::vector<int>& pinnedVertices() const { return mPinned; }
@@ -275,19 +278,21 @@ private:
     void newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
                 const VecX& v0, double h, SubstepStatus& st);
 
-    std::vector<int> mPinned;             // vertex per pin
-    std::vector<int> mPinSet;             // index into mPinSets per pin
+    std::vector<int> mPinned; // vertex per pin
+    std::vector<int> mPinSet; // index into mPinSets per pin
     std::vector<PinSet> mPinSets;
-    std::vector<std::shared_ptr<const SurfaceBinding>> mPinBinding; // per pin: its attachment, or null
-    VecX mAnchor;                         // 3 per pin: initial position
-    std::vector<uint8_t> mHeld;           // vertices in no element: held in place
+    std::vector<std::shared_ptr<const SurfaceBinding>>
+        mPinBinding;            // per pin: its attachment, or null
+    VecX mAnchor;               // 3 per pin: initial position
+    std::vector<uint8_t> mHeld; // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mEdgeRest;
     BlockMatrix mA;
     FilteredSolver mSolver;
     Constraints mConstraints;
-    std::vector<double> mContactImpulse;  // per vertex: suppressed normal speed (m/s)
-    std::vector<int> mContactCollider;    // per vertex: collider holding it in the solve, or -1
+    std::vector<double> mContactImpulse; // per vertex: suppressed normal speed (m/s)
+    std::vector<int> mContactCollider;   // per vertex: collider holding it in the solve, or -1
+    std::vector<uint8_t> mTouching;      // per vertex: touching a collider after the substep
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
@@ -297,8 +302,8 @@ private:
                              // PSD part, in A (ForceOutput::aeroPsd)
     double mStretchBefore = 0.0; // the largest edge stretch at the substep's start
     double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
-    Constraints mZeroZ;              // mConstraints with z = 0 (solveLinear's preconditioner)
-    std::vector<Mat3> mDiagInv;      // Newton's residual weights (body.cpp, newton())
+    Constraints mZeroZ;         // mConstraints with z = 0 (solveLinear's preconditioner)
+    std::vector<Mat3> mDiagInv; // Newton's residual weights (body.cpp, newton())
     double mHGuess = 0.0;
 };
 

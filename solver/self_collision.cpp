@@ -41,6 +41,11 @@ constexpr int kChunk = 64;         // primitives per parallel chunk (results ord
 constexpr int kRebuildEvery = 8;   // passes between tree rebuilds (refits in between)
 // Candidates stay valid while no vertex moves more than this × ξ from where they were gathered.
 constexpr double kMoveAllowance = 0.5;
+// Proximity: the fraction of the way back to ξ a pair already closer at the start is eased per
+// substep.
+constexpr double kEase = 0.25;
+// The inverse-mass factor of vertices touching a collider (gather()).
+constexpr double kHeldByCollider = 0.01;
 
 double seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -105,6 +110,19 @@ void SelfCollision::addBody(Body& body, const std::vector<std::array<int, 3>>& t
         mTriBody.push_back(b);
     }
     for (const auto& e : body.edges()) mEdges.push_back({e[0] + offset, e[1] + offset});
+    // Vertex neighbours by edges, CSR with sorted rows (neighbours()).
+    std::vector<std::vector<int>> rows(mVertexBody.size());
+    for (const auto& e : mEdges) {
+        rows[e[0]].push_back(e[1]);
+        rows[e[1]].push_back(e[0]);
+    }
+    mAdjacencyStart.assign(1, 0);
+    mAdjacency.clear();
+    for (auto& r : rows) {
+        std::sort(r.begin(), r.end());
+        mAdjacency.insert(mAdjacency.end(), r.begin(), r.end());
+        mAdjacencyStart.push_back(static_cast<int>(mAdjacency.size()));
+    }
     mBuilt = false;
 }
 
@@ -125,6 +143,12 @@ void SelfCollision::gather() {
             mInvMass[m.offset + i] = mMass[m.offset + i] > 0.0 ? 1.0 / mMass[m.offset + i] : 0.0;
         }
         for (int p : b.pinnedVertices()) mInvMass[m.offset + p] = 0.0;
+        // A vertex a collider holds (the ground under a pile) counts as 100× heavier: the pass
+        // then moves the cloth above it rather than pushing it into the collider, which would
+        // push it back out next substep — a fight that ratchets a resting pile's strain up.
+        const std::vector<uint8_t>& touching = b.colliderContacts();
+        for (size_t i = 0; i < touching.size(); ++i)
+            if (touching[i]) mInvMass[m.offset + i] *= kHeldByCollider;
     }
 }
 
@@ -222,6 +246,23 @@ double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) co
         side = std::max(side, (d[k] - mean).norm());
     }
     return (la + lb) * (1.0 + 1e-12);
+}
+
+bool SelfCollision::adjacent(int a, int b) const {
+    const auto begin = mAdjacency.begin() + mAdjacencyStart[a];
+    const auto end = mAdjacency.begin() + mAdjacencyStart[a + 1];
+    return std::binary_search(begin, end, b);
+}
+
+bool SelfCollision::neighbours(const Pair& p, bool vertexTriangle) const {
+    // One edge apart: a vertex and a triangle with a corner next to it, or edges whose ends are
+    // joined by an edge. Such a pair comes within ξ only where the cloth creases over an edge;
+    // repelling it would fight the crease (bending), stretch the cloth and, in a resting pile,
+    // ratchet strain up substep after substep. CCD still keeps it from crossing.
+    if (vertexTriangle)
+        return adjacent(p.v[0], p.v[1]) || adjacent(p.v[0], p.v[2]) || adjacent(p.v[0], p.v[3]);
+    return adjacent(p.v[0], p.v[2]) || adjacent(p.v[0], p.v[3]) || adjacent(p.v[1], p.v[2]) ||
+           adjacent(p.v[1], p.v[3]);
 }
 
 bool SelfCollision::restClose(const Pair& p, bool vertexTriangle) const {
@@ -347,7 +388,7 @@ int SelfCollision::proximity() {
                 Pair p0 = p;
                 const Vec3 r0 = closestPair(mX0, p0, vt, d0);
                 if (!(d1 < xi) && !(d0 < xi)) return;
-                if (restClose(p, vt)) return;
+                if (restClose(p, vt) || neighbours(p, vt)) return;
                 Vec3 n;
                 if (d0 > kTouching) {
                     n = contactNormal(mX0, p0, vt, r0, d0);
@@ -357,7 +398,14 @@ int SelfCollision::proximity() {
                 } else {
                     return;
                 }
-                out.push_back({p, n, xi});
+                // A pair already closer than ξ at the start (resting contact, a pile) is kept from
+                // closing further and eased a quarter of the way back to ξ per substep: pushing
+                // it the whole way every substep fights gravity and the cloth's own elasticity
+                // and ratchets strain up in a resting pile.
+                const double g0 = n.dot(relative(mX0, p));
+                const double target =
+                    g0 < xi ? std::max(0.0, g0) + kEase * (xi - std::max(0.0, g0)) : xi;
+                out.push_back({p, n, target});
             });
         contacts.insert(contacts.end(), found.begin(), found.end());
     }

@@ -81,6 +81,8 @@ private:
     void refitBoxes(bool swept, double inflate);
     void gatherCandidates(std::vector<Pair>& vt, std::vector<Pair>& ee) const;
     bool restClose(const Pair& p, bool vertexTriangle) const;
+    bool adjacent(int a, int b) const;
+    bool neighbours(const Pair& p, bool vertexTriangle) const;
     double relativeMotionBound(const Pair& p, bool vertexTriangle) const;
     int proximity();
     // One CCD detection over the step (and, with `apply`, the corrections); `zone`: per vertex
@@ -107,6 +109,7 @@ private:
     std::vector<std::array<int, 3>> mTris; // global vertices
     std::vector<int> mTriBody;
     std::vector<std::array<int, 2>> mEdges;
+    std::vector<int> mAdjacencyStart, mAdjacency; // vertex neighbours by edges (CSR)
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
     contact::Bvh mVertTree, mTriTree, mEdgeTree;
     std::vector<Pair> mCandVt, mCandEe;
