@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 
 namespace gale::solver {
 
@@ -30,18 +29,6 @@ double seconds(std::chrono::steady_clock::time_point a) {
 MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
     : mMesh(std::move(mesh)) {
     mEdges = meshEdges(mMesh->triangles());
-    std::map<std::pair<int, int>, int> index;
-    for (size_t e = 0; e < mEdges.size(); ++e)
-        index[{mEdges[e][0], mEdges[e][1]}] = static_cast<int>(e);
-    mTriEdges.resize(mMesh->triangles().size());
-    for (size_t t = 0; t < mTriEdges.size(); ++t) {
-        const auto& tri = mMesh->triangles()[t];
-        for (int k = 0; k < 3; ++k) {
-            const int a = std::min(tri[k], tri[(k + 1) % 3]),
-                      b = std::max(tri[k], tri[(k + 1) % 3]);
-            mTriEdges[t][k] = index[{a, b}];
-        }
-    }
 }
 
 Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
@@ -78,11 +65,26 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
         b.inflate(margin);
         mBoxes[k] = b;
     }
+    // The body's edges get their own tree: an edge–edge query then meets only the edges whose
+    // swept boxes reach the cloth edge's, not every edge of every triangle it reaches (each
+    // three times, to be sorted and made unique).
+    mEdgeBoxes.resize(mEdges.size());
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        contact::Box b;
+        for (int c = 0; c < 2; ++c) {
+            b.add(corner(false, mEdges[e][c]));
+            b.add(corner(true, mEdges[e][c]));
+        }
+        b.inflate(margin);
+        mEdgeBoxes[e] = b;
+    }
     if (!mBuilt) {
         mBvh.build(mBoxes);
+        mEdgeBvh.build(mEdgeBoxes);
         mBuilt = true;
     } else {
         mBvh.refit(mBoxes);
+        mEdgeBvh.refit(mEdgeBoxes);
     }
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
@@ -98,16 +100,24 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     int bestTri = -1;
     double bestW[3] = {0, 0, 0};
     const auto& tris = mMesh->triangles();
-    mBvh.query(q, [&](int k) {
-        double w[3];
-        const double d2 = contact::pointTriangleDistance2(
-            x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]), corner(atEnd, tris[k][2]), w);
-        if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
-            best = d2;
-            bestTri = k;
-            std::copy(w, w + 3, bestW);
-        }
-    });
+    // A nearest-point walk: a node or triangle whose box is farther than the best distance so
+    // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
+    // it is skipped; the rest is visited in the order of a plain box query, so the result is the
+    // same. `slack` covers the rounding of the distances (about 16ε of |x|², far below it).
+    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
+    mBvh.traverse([&](const contact::Box& b) { return b.overlaps(q) && b.distance2(x) <= reach(); },
+                  [&](int k, const contact::Box& b) {
+                      if (!b.overlaps(q) || b.distance2(x) > reach()) return;
+                      double w[3];
+                      const double d2 = contact::pointTriangleDistance2(
+                          x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]),
+                          corner(atEnd, tris[k][2]), w);
+                      if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
+                          best = d2;
+                          bestTri = k;
+                          std::copy(w, w + 3, bestW);
+                      }
+                  });
     if (bestTri < 0) return false;
     const auto& t = tris[bestTri];
     Vec3 p = Vec3::Zero(), v = Vec3::Zero();
@@ -184,7 +194,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             double first = 2.0;
             int hitTri = -1;
             cand.clear();
-            mBvh.query(q, [&](int k) { cand.push_back(k); });
+            mBvh.queryEach(q, [&](int k) { cand.push_back(k); });
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
@@ -242,11 +252,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             q.add(b1);
             q.inflate(thickness);
             cand.clear();
-            mBvh.query(q, [&](int k) {
-                for (int c = 0; c < 3; ++c) cand.push_back(mTriEdges[k][c]);
-            });
+            // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
+            // of the triangles reached whose boxes do not are farther than the thickness from
+            // the cloth edge throughout the step (their boxes are inflated by the margin, the
+            // query by the thickness, and CCD asks for half of it), so they cannot be hit.
+            mEdgeBvh.queryEach(q, [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end());
-            cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
