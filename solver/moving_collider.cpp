@@ -24,6 +24,39 @@ namespace {
 double seconds(std::chrono::steady_clock::time_point a) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
 }
+// A cull before the CCD that gives its answer without its first distance: contact::accd
+// (ccd.cpp) returns "no contact" at its first safe advance when stepFraction (d − ξ)/l_p ≥ 1,
+// d the start distance and l_p its bound on the relative speed (the corners' displacements
+// less their mean: the largest of each primitive's, summed, rounded up by 1e-12). With
+// `lower` ≤ d (the distance between the two primitives' boxes at the start, a lower bound) the
+// same holds for d, so the pair is clear. `lower` is shrunk by 1e-12 of the scale first (the
+// rounding of d is near 16ε of it), and l_p is taken 1e-9 larger than accd's: only pairs that
+// accd certainly rejects at its first test are culled, so the hits are those of the CCD alone.
+bool clearAtFirstAdvance(const Vec3 x[4], const Vec3 x1[4], int firstCount, double lower,
+                         const contact::CcdOptions& opt) {
+    Vec3 dx[4], mean = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) {
+        dx[i] = x1[i] - x[i];
+        mean += dx[i];
+    }
+    mean /= 4.0;
+    double scale = 1.0, la = 0.0, lb = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        double& l = i < firstCount ? la : lb;
+        l = std::max(l, (dx[i] - mean).norm());
+        scale = std::max(scale, x[i].cwiseAbs().maxCoeff());
+    }
+    lower -= 1e-12 * scale;
+    const double xi = opt.thickness;
+    if (!(lower > xi + 2e-12 * scale + opt.gapTolerance)) return false; // near: let ACCD decide
+    const double lp = (la + lb) * (1.0 + 1e-9);
+    return opt.stepFraction * (lower - xi) >= lp * (1.0 + 1e-9);
+}
+
+double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+    return std::sqrt((alo - bhi).cwiseMax(blo - ahi).cwiseMax(0.0).squaredNorm());
+}
+
 } // namespace
 
 MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
@@ -201,6 +234,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             for (int k : cand) {
                 const auto& t = tris[k];
                 double toi;
+                const Vec3 s0[4] = {p0, corner(false, t[0]), corner(false, t[1]),
+                                    corner(false, t[2])};
+                const Vec3 s1[4] = {p1, corner(true, t[0]), corner(true, t[1]), corner(true, t[2])};
+                const Vec3 lo = s0[1].cwiseMin(s0[2]).cwiseMin(s0[3]),
+                           hi = s0[1].cwiseMax(s0[2]).cwiseMax(s0[3]);
+                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
                 if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
                                                corner(false, t[1]), corner(true, t[1]),
                                                corner(false, t[2]), corner(true, t[2]), opt, toi) &&
@@ -266,6 +305,13 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             for (int k : cand) {
                 const int r = mEdges[k][0], s = mEdges[k][1];
                 double toi;
+                const Vec3 s0[4] = {a0, b0, corner(false, r), corner(false, s)};
+                const Vec3 s1[4] = {a1, b1, corner(true, r), corner(true, s)};
+                if (clearAtFirstAdvance(s0, s1, 2,
+                                        boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0),
+                                               s0[2].cwiseMin(s0[3]), s0[2].cwiseMax(s0[3])),
+                                        opt))
+                    continue;
                 if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
                                          corner(false, s), corner(true, s), opt, toi) &&
                     toi < first) {
