@@ -88,7 +88,7 @@ Run ballRun(const Sphere& ball, int res, int substeps, double thickness, int fra
         c.moving->prepare(f / fps, f / fps, 0.0); // the body at the frame's end
         for (size_t i = 0; i < sheet->vertexCount(); ++i) {
             ContactPoint cp;
-            if (c.moving->closest(vec3At(sheet->positions().data(), i), true, 0.5, cp))
+            if (c.moving->closest(vec3At(sheet->positions().data(), i), true, 0.1, cp))
                 r.closest = std::min(r.closest, cp.distance);
         }
     }

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 
 namespace gale::solver {
 
@@ -25,23 +24,44 @@ namespace {
 double seconds(std::chrono::steady_clock::time_point a) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
 }
+// A cull before the CCD that gives its answer without its first distance: contact::accd
+// (ccd.cpp) returns "no contact" at its first safe advance when stepFraction (d − ξ)/l_p ≥ 1,
+// d the start distance and l_p its bound on the relative speed (the corners' displacements
+// less their mean: the largest of each primitive's, summed, rounded up by 1e-12). With
+// `lower` ≤ d (the distance between the two primitives' boxes at the start, a lower bound) the
+// same holds for d, so the pair is clear. `lower` is shrunk by 1e-12 of the scale first (the
+// rounding of d is near 16ε of it), and l_p is taken 1e-9 larger than accd's: only pairs that
+// accd certainly rejects at its first test are culled, so the hits are those of the CCD alone.
+bool clearAtFirstAdvance(const Vec3 x[4], const Vec3 x1[4], int firstCount, double lower,
+                         const contact::CcdOptions& opt) {
+    Vec3 dx[4], mean = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) {
+        dx[i] = x1[i] - x[i];
+        mean += dx[i];
+    }
+    mean /= 4.0;
+    double scale = 1.0, la = 0.0, lb = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        double& l = i < firstCount ? la : lb;
+        l = std::max(l, (dx[i] - mean).norm());
+        scale = std::max(scale, x[i].cwiseAbs().maxCoeff());
+    }
+    lower -= 1e-12 * scale;
+    const double xi = opt.thickness;
+    if (!(lower > xi + 2e-12 * scale + opt.gapTolerance)) return false; // near: let ACCD decide
+    const double lp = (la + lb) * (1.0 + 1e-9);
+    return opt.stepFraction * (lower - xi) >= lp * (1.0 + 1e-9);
+}
+
+double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+    return std::sqrt((alo - bhi).cwiseMax(blo - ahi).cwiseMax(0.0).squaredNorm());
+}
+
 } // namespace
 
 MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
     : mMesh(std::move(mesh)) {
     mEdges = meshEdges(mMesh->triangles());
-    std::map<std::pair<int, int>, int> index;
-    for (size_t e = 0; e < mEdges.size(); ++e)
-        index[{mEdges[e][0], mEdges[e][1]}] = static_cast<int>(e);
-    mTriEdges.resize(mMesh->triangles().size());
-    for (size_t t = 0; t < mTriEdges.size(); ++t) {
-        const auto& tri = mMesh->triangles()[t];
-        for (int k = 0; k < 3; ++k) {
-            const int a = std::min(tri[k], tri[(k + 1) % 3]),
-                      b = std::max(tri[k], tri[(k + 1) % 3]);
-            mTriEdges[t][k] = index[{a, b}];
-        }
-    }
 }
 
 Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
@@ -78,11 +98,26 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
         b.inflate(margin);
         mBoxes[k] = b;
     }
+    // The body's edges get their own tree: an edge–edge query then meets only the edges whose
+    // swept boxes reach the cloth edge's, not every edge of every triangle it reaches (each
+    // three times, to be sorted and made unique).
+    mEdgeBoxes.resize(mEdges.size());
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        contact::Box b;
+        for (int c = 0; c < 2; ++c) {
+            b.add(corner(false, mEdges[e][c]));
+            b.add(corner(true, mEdges[e][c]));
+        }
+        b.inflate(margin);
+        mEdgeBoxes[e] = b;
+    }
     if (!mBuilt) {
         mBvh.build(mBoxes);
+        mEdgeBvh.build(mEdgeBoxes);
         mBuilt = true;
     } else {
         mBvh.refit(mBoxes);
+        mEdgeBvh.refit(mEdgeBoxes);
     }
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
@@ -98,16 +133,24 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     int bestTri = -1;
     double bestW[3] = {0, 0, 0};
     const auto& tris = mMesh->triangles();
-    mBvh.query(q, [&](int k) {
-        double w[3];
-        const double d2 = contact::pointTriangleDistance2(
-            x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]), corner(atEnd, tris[k][2]), w);
-        if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
-            best = d2;
-            bestTri = k;
-            std::copy(w, w + 3, bestW);
-        }
-    });
+    // A nearest-point walk: a node or triangle whose box is farther than the best distance so
+    // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
+    // it is skipped; the rest is visited in the order of a plain box query, so the result is the
+    // same. `slack` covers the rounding of the distances (about 16ε of |x|², far below it).
+    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
+    mBvh.traverse([&](const contact::Box& b) { return b.overlaps(q) && b.distance2(x) <= reach(); },
+                  [&](int k, const contact::Box& b) {
+                      if (!b.overlaps(q) || b.distance2(x) > reach()) return;
+                      double w[3];
+                      const double d2 = contact::pointTriangleDistance2(
+                          x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]),
+                          corner(atEnd, tris[k][2]), w);
+                      if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
+                          best = d2;
+                          bestTri = k;
+                          std::copy(w, w + 3, bestW);
+                      }
+                  });
     if (bestTri < 0) return false;
     const auto& t = tris[bestTri];
     Vec3 p = Vec3::Zero(), v = Vec3::Zero();
@@ -184,13 +227,19 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             double first = 2.0;
             int hitTri = -1;
             cand.clear();
-            mBvh.query(q, [&](int k) { cand.push_back(k); });
+            mBvh.queryEach(q, [&](int k) { cand.push_back(k); });
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
             for (int k : cand) {
                 const auto& t = tris[k];
                 double toi;
+                const Vec3 s0[4] = {p0, corner(false, t[0]), corner(false, t[1]),
+                                    corner(false, t[2])};
+                const Vec3 s1[4] = {p1, corner(true, t[0]), corner(true, t[1]), corner(true, t[2])};
+                const Vec3 lo = s0[1].cwiseMin(s0[2]).cwiseMin(s0[3]),
+                           hi = s0[1].cwiseMax(s0[2]).cwiseMax(s0[3]);
+                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
                 if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
                                                corner(false, t[1]), corner(true, t[1]),
                                                corner(false, t[2]), corner(true, t[2]), opt, toi) &&
@@ -242,11 +291,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             q.add(b1);
             q.inflate(thickness);
             cand.clear();
-            mBvh.query(q, [&](int k) {
-                for (int c = 0; c < 3; ++c) cand.push_back(mTriEdges[k][c]);
-            });
+            // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
+            // of the triangles reached whose boxes do not are farther than the thickness from
+            // the cloth edge throughout the step (their boxes are inflated by the margin, the
+            // query by the thickness, and CCD asks for half of it), so they cannot be hit.
+            mEdgeBvh.queryEach(q, [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end());
-            cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
@@ -255,6 +305,13 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             for (int k : cand) {
                 const int r = mEdges[k][0], s = mEdges[k][1];
                 double toi;
+                const Vec3 s0[4] = {a0, b0, corner(false, r), corner(false, s)};
+                const Vec3 s1[4] = {a1, b1, corner(true, r), corner(true, s)};
+                if (clearAtFirstAdvance(s0, s1, 2,
+                                        boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0),
+                                               s0[2].cwiseMin(s0[3]), s0[2].cwiseMax(s0[3])),
+                                        opt))
+                    continue;
                 if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
                                          corner(false, s), corner(true, s), opt, toi) &&
                     toi < first) {

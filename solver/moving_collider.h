@@ -57,11 +57,11 @@ private:
     Vec3 faceNormal(bool atEnd, int tri) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
-    std::vector<std::array<int, 2>> mEdges;    // unique body edges
-    std::vector<std::array<int, 3>> mTriEdges; // per triangle: its three edges
-    std::vector<double> mP0, mP1;              // corners at t0 and t1
-    std::vector<contact::Box> mBoxes;
-    contact::Bvh mBvh;
+    std::vector<std::array<int, 2>> mEdges; // unique body edges
+    std::vector<double> mP0, mP1;           // corners at t0 and t1
+    std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
+    std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
+    contact::Bvh mBvh, mEdgeBvh;
     bool mBuilt = false;
     double mT0 = NAN, mT1 = NAN, mMargin = NAN;
     MovingContactStats mStats;

@@ -73,24 +73,7 @@ void Bvh::refit(const std::vector<Box>& boxes) {
 }
 
 std::size_t Bvh::query(const Box& q, const std::function<void(int)>& fn) const {
-    if (mOrder.empty()) return 0;
-    std::size_t visited = 0;
-    int stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const Node& n = mNodes[stack[--top]];
-        ++visited;
-        if (!n.box.overlaps(q)) continue;
-        if (n.left < 0) {
-            for (int i = n.begin; i < n.end; ++i)
-                if (mBoxes[mOrder[i]].overlaps(q)) fn(mOrder[i]);
-        } else {
-            stack[top++] = n.left;
-            stack[top++] = n.right;
-        }
-    }
-    return visited;
+    return queryEach(q, fn);
 }
 
 } // namespace gale::solver::contact

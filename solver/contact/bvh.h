@@ -30,6 +30,10 @@ struct Box {
     bool overlaps(const Box& b) const {
         return (lo.array() <= b.hi.array()).all() && (b.lo.array() <= hi.array()).all();
     }
+    // The squared distance from p to the box (0 inside): a lower bound for any point in it.
+    double distance2(const Eigen::Vector3d& p) const {
+        return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).squaredNorm();
+    }
 };
 
 class Bvh {
@@ -45,6 +49,38 @@ public:
     // them have neighbours). With other == *this, each unordered pair a ≠ b comes once.
     template <class Fn>
     void overlappingPairs(const Bvh& other, Fn&& fn) const;
+    // The same walk without std::function (the visitor inlined): fn(primitive) in query()'s order.
+    template <class Fn>
+    std::size_t queryEach(const Box& q, Fn&& fn) const {
+        return traverse([&](const Box& b) { return b.overlaps(q); },
+                        [&](int i, const Box& b) {
+                            if (b.overlaps(q)) fn(i);
+                        });
+    }
+    // Depth-first, in query()'s order (left subtree first), into every node whose box passes
+    // enter(box), calling leaf(primitive, box) for the primitives of the leaves reached. enter
+    // may tighten as the walk goes (a nearest-point search shrinking its radius). Returns the
+    // nodes visited.
+    template <class Enter, class Leaf>
+    std::size_t traverse(Enter&& enter, Leaf&& leaf) const {
+        if (mOrder.empty()) return 0;
+        std::size_t visited = 0;
+        int stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top > 0) {
+            const Node& n = mNodes[stack[--top]];
+            ++visited;
+            if (!enter(n.box)) continue;
+            if (n.left < 0) {
+                for (int i = n.begin; i < n.end; ++i) leaf(mOrder[i], mBoxes[mOrder[i]]);
+            } else {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            }
+        }
+        return visited;
+    }
     std::size_t nodeCount() const { return mNodes.size(); }
     std::size_t primitiveCount() const { return mOrder.size(); }
     const Box& rootBox() const { return mNodes.front().box; }

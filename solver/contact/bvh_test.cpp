@@ -90,4 +90,45 @@ TEST_CASE("bvh: overlapping pairs of two trees and of one tree match brute force
     std::sort(got.begin(), got.end());
     CHECK(std::adjacent_find(got.begin(), got.end()) == got.end());
     CHECK(got == want);
+TEST_CASE("bvh: queryEach visits query's primitives in its order; a pruned walk finds the nearest",
+          "[contact][bvh]") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    std::vector<Box> boxes(3000);
+    for (Box& b : boxes) {
+        const Eigen::Vector3d c(U(rng), U(rng), U(rng));
+        b.add(c);
+        b.add(c + Eigen::Vector3d(0.02 * U(rng), 0.02 * U(rng), 0.02 * U(rng)));
+    }
+    Bvh bvh;
+    bvh.build(boxes);
+    for (int q = 0; q < 100; ++q) {
+        const Eigen::Vector3d p(U(rng), U(rng), U(rng));
+        Box query;
+        query.add(p);
+        query.inflate(0.05);
+        std::vector<int> a, b;
+        const size_t va = bvh.query(query, [&](int i) { a.push_back(i); });
+        const size_t vb = bvh.queryEach(query, [&](int i) { b.push_back(i); });
+        REQUIRE(a == b); // same primitives, same order
+        CHECK(va == vb);
+        // The nearest box to p (distance 0 inside), by brute force and by a walk that skips
+        // every node farther than the best so far.
+        double want = INFINITY;
+        for (const Box& x : boxes) want = std::min(want, x.distance2(p));
+        double best = INFINITY;
+        size_t leaves = 0;
+        bvh.traverse([&](const Box& n) { return n.distance2(p) <= best; },
+                     [&](int, const Box& x) {
+                         ++leaves;
+                         best = std::min(best, x.distance2(p));
+                     });
+        CHECK(best == want);
+        CHECK(leaves < boxes.size() / 10); // the pruning skips most of the tree
+    }
+    Box unit;
+    unit.add(Eigen::Vector3d(0, 0, 0));
+    unit.add(Eigen::Vector3d(1, 1, 1));
+    CHECK(unit.distance2(Eigen::Vector3d(0.5, 0.5, 0.5)) == 0.0);
+    CHECK(unit.distance2(Eigen::Vector3d(2, 0.5, -1)) == Approx(2.0)); // 1² + 1²
 }
