@@ -90,6 +90,8 @@ TEST_CASE("bvh: overlapping pairs of two trees and of one tree match brute force
     std::sort(got.begin(), got.end());
     CHECK(std::adjacent_find(got.begin(), got.end()) == got.end());
     CHECK(got == want);
+}
+
 TEST_CASE("bvh: queryEach visits query's primitives in its order; a pruned walk finds the nearest",
           "[contact][bvh]") {
     std::mt19937 rng(7);
