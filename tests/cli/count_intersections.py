@@ -3,11 +3,13 @@
 phase, edge/plane crossings tested against the other triangle by barycentric coordinates), and
 optionally the minimum distance between vertex-triangle pairs that share no vertex.
 
-Usage: count_intersections.py [--json] [--min-distance] FRAME.obj...
+Usage: count_intersections.py [--json] [--min-distance] [--reach=METRES] FRAME.obj...
 Prints one line per frame (`FILE PAIRS [MIN_DISTANCE]`) and a total; --json prints one object
 {"frames": [{"file", "pairs", "min_distance"?}], "frames_with_intersections", "pairs"} instead.
 Pairs counted: triangles sharing no vertex whose edges cross the other's interior, and triangles
 sharing one vertex whose opposite edge crosses the other (neighbours sharing an edge never count).
+--min-distance looks at pairs within --reach (default: a tenth of the mean edge length); a
+value above the reach is an upper bound of the minimum, not the minimum.
 Exit status 0 when every file was read; 2 on a bad argument or an unreadable or malformed file.
 """
 import json
@@ -143,11 +145,16 @@ def minimumDistance(V, F, reach):
 
 def main(argv):
     args = [a for a in argv if not a.startswith('--')]
-    flags = {a for a in argv if a.startswith('--')}
+    flags = {a for a in argv if a.startswith('--') and not a.startswith('--reach=')}
+    reaches = [a[len('--reach='):] for a in argv if a.startswith('--reach=')]
     unknown = flags - {'--json', '--min-distance'}
+    try:
+        reachArg = float(reaches[-1]) if reaches else None
+    except ValueError:
+        unknown.add('--reach=' + reaches[-1])
     if unknown or not args:
         sys.stderr.write(f'count_intersections.py: {"unknown option " + min(unknown) if unknown else "no OBJ files"}\n'
-                         'usage: count_intersections.py [--json] [--min-distance] FRAME.obj...\n')
+                         'usage: count_intersections.py [--json] [--min-distance] [--reach=METRES] FRAME.obj...\n')
         return 2
     frames = []
     for path in args:
@@ -161,6 +168,7 @@ def main(argv):
             # Pairs within a tenth of the mean edge length: far enough for any thickness tested.
             E = V[F[:, [1, 2, 0]]] - V[F]
             reach = 0.1 * float(np.linalg.norm(E, axis=2).mean()) if len(F) else 0.0
+            reach = reachArg if reachArg is not None else reach
             row['min_distance'] = minimumDistance(V, F, reach)
         frames.append(row)
     total = sum(r['pairs'] for r in frames)
