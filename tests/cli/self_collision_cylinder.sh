@@ -22,11 +22,12 @@ with open('tube.obj', 'w') as f:
         for k in range(around):
             a, b = j * around + k + 1, j * around + (k + 1) % around + 1
             f.write('f %d %d %d\nf %d %d %d\n' % (a, b, b + around, a, b + around, a + around))
-# The far ring as a body: its vertices and a fan round its centre, turning -half a turn in 2 s.
+# The far ring as a body: its vertices and a fan round its centre; frame F is at t = F / 24 s,
+# turned by -half a turn * min(t / 2 s, 1) (the pin's keys the other way).
 os.makedirs('ring', exist_ok=True)
 for fr in range(1, frames + 2):
     with open('ring/ring.%04d.obj' % fr, 'w') as f:
-        for p in ring(length / 2, -2 * math.pi * turns * (fr - 1) / 48):
+        for p in ring(length / 2, -2 * math.pi * turns * min(fr / 48, 1)):
             f.write('v %.9f %.9f %.9f\n' % p)
         f.write('v %.9f 0 0.6\n' % (length / 2))
         for k in range(around):
@@ -61,20 +62,28 @@ tube false > off.toml
 run "$GALE" sim on.toml -o on
 expect_rc 0 "the twisted tube with self-collision"
 expect_clean on tube "the twisted cylinder"
-# Frame 49 is t = 2 s: the near ring has turned +180 deg about x (y, z - 0.6 negated), the far
-# ring -180 deg (the same), both to the rounding of the OBJ output.
-ends=$("$PY" - <<'PY'
+# The rings at frames 24 and 48 (t = F / 24 s): the near one turned +F x 3.75 deg about the axis
+# (x, through z = 0.6) by its pin keys; the far one by its body's turn since frame 1, where the
+# attachment was bound: -(F - 1) x 3.75 deg. Both to the rounding of the OBJ output.
+for frame in 24 48; do
+    err=$("$PY" - "$frame" <<'PY'
+import math, sys
 def verts(p):
     return [list(map(float, l.split()[1:4])) for l in open(p) if l.startswith('v ')]
-a, b = verts('tube.obj'), verts('on/tube.0049.obj')
+frame = int(sys.argv[1])
+a, b = verts('tube.obj'), verts('on/tube.%04d.obj' % frame)
 err = 0.0
 for i in list(range(24)) + list(range(23 * 24, 24 * 24)):
-    want = (a[i][0], -a[i][1], 1.2 - a[i][2])
+    turn = math.radians(3.75 * frame if i < 24 else -3.75 * (frame - 1))
+    y, z = a[i][1], a[i][2] - 0.6
+    want = (a[i][0], y * math.cos(turn) - z * math.sin(turn), 0.6 + y * math.sin(turn) + z * math.cos(turn))
     err = max(err, max(abs(u - v) for u, v in zip(want, b[i])))
 print('%.2e' % err)
 PY
-)
-awk -v e="$ends" 'BEGIN { exit !(e != "" && e < 1e-5) }' || fail "the end rings turned half a turn each way at frame 49: off by $ends m"
+    )
+    awk -v e="$err" 'BEGIN { exit !(e != "" && e < 1e-5) }' ||
+        fail "the end rings turned the opposite ways at frame $frame: off by $err m"
+done
 
 run "$GALE" sim off.toml -o off
 expect_rc 0 "the twisted tube without self-collision"
