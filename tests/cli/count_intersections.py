@@ -23,15 +23,23 @@ def load(path):
     vertices, faces = [], []
     with open(path) as f:
         for number, line in enumerate(f, 1):
-            if line.startswith('v '):
-                vertices.append([float(x) for x in line.split()[1:4]])
-            elif line.startswith('f '):
+            try:
+                if line.startswith('v '):
+                    xyz = [float(x) for x in line.split()[1:4]]
+                    if len(xyz) != 3:
+                        raise ValueError
+                    vertices.append(xyz)
+                    continue
+                if not line.startswith('f '):
+                    continue
                 ids = [int(x.split('/')[0]) for x in line.split()[1:]]
-                ids = [i - 1 if i > 0 else len(vertices) + i for i in ids]
-                if len(ids) < 3 or min(ids) < 0 or max(ids) >= len(vertices):
-                    raise ValueError(f'{path}:{number}: bad face (vertex index out of range)')
-                for k in range(1, len(ids) - 1):
-                    faces.append([ids[0], ids[k], ids[k + 1]])
+            except ValueError:
+                raise ValueError(f'{path}:{number}: not a vertex or face line of numbers: {line.strip()[:60]}')
+            ids = [i - 1 if i > 0 else len(vertices) + i for i in ids]
+            if len(ids) < 3 or min(ids) < 0 or max(ids) >= len(vertices):
+                raise ValueError(f'{path}:{number}: bad face (vertex index out of range)')
+            for k in range(1, len(ids) - 1):
+                faces.append([ids[0], ids[k], ids[k + 1]])
     return np.array(vertices, float).reshape(-1, 3), np.array(faces, int).reshape(-1, 3)
 
 
