@@ -21,6 +21,7 @@ count_pairs() {
 # no substep halved or rejected and no frame failed.
 expect_clean() {
     local report
+    [ -s "$1/run.json" ] || { fail "$3: no $1/run.json (the run did not finish)"; return; }
     count_pairs "$1" "$2"
     [ "$PAIRS" = 0 ] || fail "$3: $PAIRS intersecting triangle pairs in $HIT_FRAMES frames (count_intersections.py $1/$2.*.obj)"
     report=$("$PY" - "$1/run.json" "$2" <<'PYEOF'
