@@ -77,6 +77,7 @@ void SelfCollisionStats::add(const SelfCollisionStats& o) {
     ccdHits += o.ccdHits;
     ccdRounds += o.ccdRounds;
     broadPhases += o.broadPhases;
+    halvings += o.halvings;
     candidates += o.candidates;
     failSafeRuns += o.failSafeRuns;
     zoneVertices += o.zoneVertices;
@@ -260,6 +261,25 @@ Vec3 relative(const std::vector<double>& x, const SelfCollision::Pair& p) {
     return r;
 }
 
+// The direction a pair is kept apart along, from its closest-point vector r (length d) at
+// positions x: the plane normal of the triangle (vertex–triangle) or e₁ × e₂ (edge–edge) signed
+// like r when r is within 45° of it — a vertex over a face, edges crossing — else r / d (a
+// vertex beside an edge, edges side by side). Closest points alone tilt the normal of a near
+// hit far from the face and push cloth sideways, stretching it.
+Vec3 contactNormal(const std::vector<double>& x, const SelfCollision::Pair& p, bool vertexTriangle,
+                   const Vec3& r, double d) {
+    const auto at = [&](int k) { return Vec3(vec3At(x.data(), p.v[k])); };
+    const Vec3 c = vertexTriangle ? Vec3((at(2) - at(1)).cross(at(3) - at(1)))
+                                  : Vec3((at(1) - at(0)).cross(at(3) - at(2)));
+    const double cn = c.norm();
+    const Vec3 rn = r / d;
+    if (cn > 0.0) {
+        const double cosine = c.dot(rn) / cn;
+        if (std::abs(cosine) > 0.7071) return (cosine > 0.0 ? 1.0 : -1.0) * c / cn;
+    }
+    return rn;
+}
+
 // Moves the pair's relative position by Δ along n, momentum-conserving (file comment).
 void correct(std::vector<double>& x, const std::vector<double>& invMass,
              const SelfCollision::Pair& p, const Vec3& n, double delta) {
@@ -319,17 +339,24 @@ int SelfCollision::proximity() {
                 double d1 = 0.0, d0 = 0.0;
                 const Vec3 r1 = closestPair(mX1, p, vt, d1);
                 const double xi = pairThickness(p);
-                if (!(d1 - relativeMotionBound(p, vt) > mSettings.ccdFraction * xi)) maybe[c] = 1;
-                if (!(d1 < xi) || restClose(p, vt)) return;
+                const double l = relativeMotionBound(p, vt);
+                if (!(d1 - l > mSettings.ccdFraction * xi)) maybe[c] = 1;
+                // Within ξ at the end, or at the start (d₀ ≥ d₁ − l): a pair in resting contact
+                // keeps its side and normal from x₀ even when the step would take it through.
+                if (!(d1 < xi) && !(d1 - l < xi)) return;
                 Pair p0 = p;
                 const Vec3 r0 = closestPair(mX0, p0, vt, d0);
+                if (!(d1 < xi) && !(d0 < xi)) return;
+                if (restClose(p, vt)) return;
                 Vec3 n;
-                if (d0 > kTouching)
-                    n = r0 / d0;
-                else if (d1 > kTouching)
-                    n = r1 / d1;
-                else
+                if (d0 > kTouching) {
+                    n = contactNormal(mX0, p0, vt, r0, d0);
+                    if (d0 < xi) p = p0; // the start's closest points
+                } else if (d1 > kTouching) {
+                    n = contactNormal(mX1, p, vt, r1, d1);
+                } else {
                     return;
+                }
                 out.push_back({p, n, xi});
             });
         contacts.insert(contacts.end(), found.begin(), found.end());
@@ -403,18 +430,17 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 const Vec3 rt = closestPair(xt, local, vt, dt);
                 Vec3 n;
                 if (dt > kTouching) {
-                    n = rt / dt;
+                    n = contactNormal(xt, local, vt, rt, dt);
                 } else {
                     Pair q = p;
                     double dd = 0.0;
                     const Vec3 r0 = closestPair(mX0, q, vt, dd);
-                    n = r0 / dd;
+                    n = contactNormal(mX0, q, vt, r0, dd);
                 }
                 p.a = local.a;
-                // The gap along n at x₀, and the end gap the correction asks for: half-way between
-                // it and the CCD thickness (a margin, so the pair is clear in the next round).
-                const double g0 = n.dot(relative(mX0, p));
-                hitsOut.push_back({p, n, 0.5 * (g0 + xiUsed)});
+                // Inelastic: the pair ends where it met, just outside the CCD thickness (a 10 %
+                // margin, so the next round finds it clear), its approach along n removed.
+                hitsOut.push_back({p, n, std::max(dt, 1.1 * xiUsed)});
             });
         found.insert(found.end(), out.begin(), out.end());
     }
@@ -598,7 +624,6 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
         }
         dirty = dirtySince(before);
     }
-    mMaybeValid = false;
     if (!clear && ccdRound(false, &hits, nullptr, &dirty) > 0) impactZones(hits);
     mStats.passes = 1;
     ++mPasses;

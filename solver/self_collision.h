@@ -26,8 +26,9 @@ struct SelfCollisionStats {
     long long zoneVertices = 0;   // vertices moved rigidly by impact zones, summed
     long long frozenVertices = 0; // vertices held at x₀ by the last resort
     long long unresolved = 0;     // hits left after every stage (a guarantee breach; reported)
-    long long startTouching =
-        0; // pairs skipped because they start touching or crossing (max per pass)
+    long long halvings = 0;       // substeps the World halved because a pass stretched cloth
+    // Pairs skipped because they start touching or crossing (the most in one pass).
+    long long startTouching = 0;
     double broadSeconds = 0.0, proximitySeconds = 0.0, ccdSeconds = 0.0, failSafeSeconds = 0.0;
     void add(const SelfCollisionStats& o);
 };

@@ -17,6 +17,10 @@ namespace gale::solver {
 namespace {
 // Newton iterations of the retry of a substep in trouble (World::advanceBody).
 constexpr int kRetryNewtonIterations = 16;
+// A self-collision pass that leaves an edge longer than kPassStretch × its rest length and
+// kPassStretchGrowth × what the solve left has its interval redone at half the step.
+constexpr double kPassStretch = 1.1;
+constexpr double kPassStretchGrowth = 1.05;
 } // namespace
 
 struct World::Arena {
@@ -91,26 +95,71 @@ void World::setUpSelfCollision(FrameStats& fs) {
 // start to its end (self_collision.h): the end state has no crossing the start did not have.
 void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs) {
     fs.selfCollision = true;
-    const long ticksPerBase = 1L << std::clamp(mSettings.maxHalvings, 0, 20);
-    std::vector<BodyRun> runs(mSelfBodies.size());
-    std::vector<VecX> starts(mSelfBodies.size());
-    char buf[256];
-    for (int s = 0; s < substeps; ++s) {
-        for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+    const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
+    const long ticksPerBase = 1L << maxLevel;
+    const long totalTicks = ticksPerBase * substeps;
+    const size_t n = mSelfBodies.size();
+    std::vector<BodyRun> runs(n);
+    std::vector<VecX> starts(n);
+    std::vector<Body::Snapshot> snaps(n);
+    std::vector<double> stretchBefore(n);
+    char buf[320];
+    // Collisions resolved at the end of a substep move positions without the implicit solve
+    // seeing it: a fast impact at a long substep then stretches cloth (stored energy the contact
+    // never had). When a pass stretches an edge beyond both kPassStretch and kPassStretchGrowth
+    // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
+    // step, as the solver halves a substep in trouble; the level holds for the rest of the frame.
+    int level = 0;
+    long tick = 0;
+    while (tick < totalTicks) {
+        const long end = std::min(totalTicks, tick + (ticksPerBase >> level));
+        std::vector<BodyRun> runsBefore = runs;
+        for (size_t k = 0; k < n; ++k) {
             Body& body = *mBodies[mSelfBodies[k]];
+            snaps[k] = body.snapshot();
             starts[k] = body.positions();
-            stepBody(body, t0, dt, substeps, ticksPerBase * (s + 1), runs[k],
-                     fs.bodies[mSelfBodies[k]]);
+            runs[k].level = std::max(runs[k].level, level);
+            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]]);
+            stretchBefore[k] = body.maxEdgeStretch();
         }
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
+        const double tEnd = t0 + dt * static_cast<double>(end) / static_cast<double>(totalTicks);
+        bool stretched = false;
+        double worst = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            Body& body = *mBodies[mSelfBodies[k]];
+            const double after = body.maxEdgeStretch();
+            worst = std::max(worst, after);
+            if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
+                after > body.limits().overStretch)
+                stretched = true;
+        }
+        if (stretched && level < maxLevel) {
+            for (size_t k = 0; k < n; ++k) {
+                mBodies[mSelfBodies[k]]->restore(snaps[k]);
+                BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
+                ++stats.rejected;
+                stats.deepestHalving = std::max(stats.deepestHalving, level + 1);
+            }
+            runs = runsBefore;
+            ++level;
+            ++fs.selfContacts.halvings;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision stretched cloth to %.3g × its rest length; "
+                          "substep halved to %.6g s",
+                          tEnd, worst, dt / substeps / static_cast<double>(1L << level));
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+            continue;
+        }
         if (st.unresolved > 0) {
             std::snprintf(buf, sizeof buf,
                           "t=%.6g s: self-collision left %lld pair(s) unresolved after the "
                           "fail-safe (pins or attachments moving apart inside an impact zone)",
-                          t0 + dt * (s + 1) / substeps, st.unresolved);
+                          tEnd, st.unresolved);
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
+        tick = end;
     }
     const std::vector<int> pairs = mSelf->intersectionsPerBody();
     for (size_t k = 0; k < mSelfBodies.size(); ++k) {

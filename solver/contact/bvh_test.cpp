@@ -55,3 +55,39 @@ TEST_CASE("bvh: queries match brute force, also after a refit", "[contact][bvh]"
         CHECK(bvh.rootBox().lo.x() >= 0.3 * pass - 1e-12);
     }
 }
+
+TEST_CASE("bvh: overlapping pairs of two trees and of one tree match brute force", "[contact][bvh]") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    auto boxes = [&](int n, double size) {
+        std::vector<Box> out(n);
+        for (int i = 0; i < n; ++i) {
+            const Eigen::Vector3d c(U(rng), U(rng), U(rng));
+            out[i].add(c);
+            out[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+        }
+        return out;
+    };
+    const std::vector<Box> a = boxes(700, 0.05), b = boxes(900, 0.08);
+    Bvh ta, tb;
+    ta.build(a);
+    tb.build(b);
+    std::vector<std::pair<int, int>> got, want;
+    ta.overlappingPairs(tb, [&](int i, int j) { got.emplace_back(i, j); });
+    for (int i = 0; i < 700; ++i)
+        for (int j = 0; j < 900; ++j)
+            if (a[i].overlaps(b[j])) want.emplace_back(i, j);
+    std::sort(got.begin(), got.end());
+    CHECK(got == want);
+    CHECK(!want.empty());
+    // One tree against itself: every unordered pair i ≠ j once.
+    got.clear();
+    want.clear();
+    tb.overlappingPairs(tb, [&](int i, int j) { got.emplace_back(std::min(i, j), std::max(i, j)); });
+    for (int i = 0; i < 900; ++i)
+        for (int j = i + 1; j < 900; ++j)
+            if (b[i].overlaps(b[j])) want.emplace_back(i, j);
+    std::sort(got.begin(), got.end());
+    CHECK(std::adjacent_find(got.begin(), got.end()) == got.end());
+    CHECK(got == want);
+}
