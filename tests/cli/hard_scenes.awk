@@ -2,7 +2,7 @@
 # gusts, presets, expressions), cloth densities 0.001-1 kg/m^2, hair, keyframed and rotating
 # pins, colliders, moving mesh bodies (OBJ sequences written beside the scene: boxes and thin
 # paddles flying up to 8 m/s and spinning up to 360 deg/s) and cloth or hair attached to them;
-# short and small. Deterministic: its own Park-Miller generator from `seed`.
+# self-collision on every third scene's cloth; short and small. Deterministic: its own Park-Miller generator from `seed`.
 # Usage: awk -v seed=1 -v count=50 -v out=DIR -f hard_scenes.awk
 function rnd() { state = (state * 16807) % 2147483647; return state / 2147483647 }
 function uni(a, b) { return a + (b - a) * rnd() }
@@ -118,6 +118,9 @@ BEGIN {
             fmt = "obj"; if (rnd() < 0.5) fmt = "ply"
             printf "lift = %s\ndrag = %s\naero_model = \"%s\"\naero_jacobian = \"%s\"\nlinear_solver = \"%s\"\noutput = \"%s\"\n",
                 param(0, 1.5, dur), param(0, 2, dur), model, jac, lin, fmt > f
+            # Self-collision on every third scene's cloth (chosen by index, not drawn, so the
+            # other keys of every scene stay those of the seed), with a 2 mm thickness on half.
+            if (s % 3 == 1) printf "self_collision = true\n%s", (s % 6 == 1 ? "thickness = 0.002\n" : "") > f
             if (attach) {
                 printf "attach = { mesh = \"%s.#.obj\", box = [-10, 0.999, -10, 10, 1.001, 10] }\n", seq > f
             } else if (rnd() < 0.8) {

@@ -1,10 +1,10 @@
 # Numerical faults under load: 3 × 50 randomised hard scenes (hard_scenes.awk, three fixed seeds:
 # wind 0-60 m/s from windicator keys, gusts, presets and expressions; cloth of 0.001-1 kg/m^2 and
 # hair; keyframed and rotating pins, parameters and colliders; moving mesh bodies with cloth and
-# hair attached to them) simulated two at a time. Every run exits 0 —
-# trouble is recovered (halved substeps, at the smallest one strain limiting) and reported in
-# run.json, never a give-up (exit 4), a signal or another code — and no frame written holds a
-# NaN or an infinity. GALE_HARD_SEED=N runs one other set.
+# hair attached to them; self-collision on a third of the cloth) simulated two at a time. Every
+# run exits 0 — trouble is recovered (halved substeps, at the smallest one strain limiting) and
+# reported in run.json, never a give-up (exit 4), a signal or another code — and no frame
+# written holds a NaN or an infinity. GALE_HARD_SEED=N runs one other set.
 source "$(dirname "$0")/lib.bash" "$@"
 
 SEEDS=${GALE_HARD_SEED:-20261122 7 8}
@@ -23,6 +23,8 @@ expect_eq "$(ls scenes/*.toml | wc -l)" "$COUNT" "generated scenes"
 moving=$(grep -l 'type = "mesh"' scenes/*.toml | wc -l)
 attached=$(grep -l '^attach' scenes/*.toml | wc -l)
 [ "$moving" -gt 10 ] && [ "$attached" -gt 5 ] || fail "moving bodies in $moving scenes, attachments in $attached"
+selfc=$(grep -l '^self_collision = true' scenes/*.toml | wc -l)
+[ "$selfc" -gt 10 ] || fail "self-collision in $selfc scenes"
 
 # One run: exit code to NAME.rc, stderr to NAME.err (a signal shows as 128 + its number).
 cat > one.sh <<'SH'
@@ -76,5 +78,10 @@ for scene in scenes/*.toml; do
     done
     [ "$frames" -gt 0 ] || fail "$name: no frame written (exit $rc)"
 done
+# Self-collision pairs left unresolved by the fail-safe (pins or attachments pulling a zone
+# apart) and intersections at frame ends, summed over the scenes: reported, not asserted.
+unresolved=$(cat out/*/run.json 2> /dev/null | grep -o '"unresolved": [0-9]*' | awk '{ n += $2 } END { print n + 0 }')
+intersecting=$(cat out/*/run.json 2> /dev/null | grep -o '"self_intersections": [0-9]*' | awk '{ n += $2 } END { print n + 0 }')
+echo "hard_scenes: self-collision in $selfc scenes: $unresolved pair(s) left unresolved, $intersecting intersecting pair-frames" >&2
 echo "hard_scenes: seeds $SEED ($moving with moving bodies, $attached attached): $ok of $COUNT ran to the end (exit 0), $reported gave up (exit 4) in ${seconds}s on 2 workers" >&2
 finish
