@@ -138,8 +138,11 @@ void SelfCollision::gather() {
                   mX1.begin() + 3 * m.offset);
         std::copy(b.velocities().data(), b.velocities().data() + b.velocities().size(),
                   mV.begin() + 3 * m.offset);
+        // A vertex with no mass of its own (only degenerate triangles) still moves with the
+        // solve: it gets a small one (10⁻³ of the mean) rather than counting as held.
+        const double floor = 1e-3 * b.masses().sum() / std::max<double>(1.0, b.vertexCount());
         for (size_t i = 0; i < b.vertexCount(); ++i) {
-            mMass[m.offset + i] = b.masses()[static_cast<long>(i)];
+            mMass[m.offset + i] = std::max(b.masses()[static_cast<long>(i)], floor);
             mInvMass[m.offset + i] = mMass[m.offset + i] > 0.0 ? 1.0 / mMass[m.offset + i] : 0.0;
         }
         for (int p : b.pinnedVertices()) mInvMass[m.offset + p] = 0.0;
