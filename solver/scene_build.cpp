@@ -12,10 +12,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <sstream>
 
 namespace gale::solver {
 
@@ -72,16 +74,29 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     if (spec.exprPath.empty() && spec.source.empty()) return true;
     lang::SourceFile source;
     if (!spec.exprPath.empty()) {
-        std::ifstream in(spec.exprPath, std::ios::binary);
-        if (!in) {
+        // A folder (an empty `expr`, resolved to the scene's folder) opens but cannot be read:
+        // libstdc++ then throws from the stream, so only regular files are read.
+        std::error_code ec;
+        std::ifstream in;
+        if (std::filesystem::is_regular_file(spec.exprPath, ec))
+            in.open(spec.exprPath, std::ios::binary);
+        std::string text;
+        bool ok = static_cast<bool>(in);
+        if (ok) {
+            std::ostringstream buf;
+            buf << in.rdbuf();
+            ok = !in.bad();
+            text = buf.str();
+        }
+        if (!ok) {
             fields::SceneError e = sceneError(scene, spec.line, spec.col,
-                                              what + ": cannot read '" + spec.exprPath + "'");
+                                              what + ": cannot read '" + spec.exprPath +
+                                                  "' (give the path of an expression file)");
             e.io = true;
             errors.push_back(std::move(e));
             return false;
         }
-        source = lang::SourceFile(spec.exprPath, std::string((std::istreambuf_iterator<char>(in)),
-                                                             std::istreambuf_iterator<char>()));
+        source = lang::SourceFile(spec.exprPath, std::move(text));
     } else {
         source = lang::SourceFile(scene.wind.path + " (" + what + ")", spec.source);
     }
