@@ -87,30 +87,24 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
     mT0 = t0;
     mT1 = t1;
     mMargin = margin;
-    const auto& tris = mMesh->triangles();
-    mBoxes.resize(tris.size());
-    for (size_t k = 0; k < tris.size(); ++k) {
+    // A primitive's box over the step: its corners at both ends, inflated by the margin.
+    const auto sweptBox = [&](const int* v, int count) {
         contact::Box b;
-        for (int c = 0; c < 3; ++c) {
-            b.add(corner(false, tris[k][c]));
-            b.add(corner(true, tris[k][c]));
+        for (int c = 0; c < count; ++c) {
+            b.add(corner(false, v[c]));
+            b.add(corner(true, v[c]));
         }
         b.inflate(margin);
-        mBoxes[k] = b;
-    }
+        return b;
+    };
+    const auto& tris = mMesh->triangles();
+    mBoxes.resize(tris.size());
+    for (size_t k = 0; k < tris.size(); ++k) mBoxes[k] = sweptBox(tris[k].data(), 3);
     // The body's edges get their own tree: an edge–edge query then meets only the edges whose
     // swept boxes reach the cloth edge's, not every edge of every triangle it reaches (each
     // three times, to be sorted and made unique).
     mEdgeBoxes.resize(mEdges.size());
-    for (size_t e = 0; e < mEdges.size(); ++e) {
-        contact::Box b;
-        for (int c = 0; c < 2; ++c) {
-            b.add(corner(false, mEdges[e][c]));
-            b.add(corner(true, mEdges[e][c]));
-        }
-        b.inflate(margin);
-        mEdgeBoxes[e] = b;
-    }
+    for (size_t e = 0; e < mEdges.size(); ++e) mEdgeBoxes[e] = sweptBox(mEdges[e].data(), 2);
     if (!mBuilt) {
         mBvh.build(mBoxes);
         mEdgeBvh.build(mEdgeBoxes);
