@@ -12,5 +12,6 @@ drag = { expr = "" }
 TOML
 run "$GALE" sim scene.toml -o out
 expect_rc 1 "an empty drag expr"
-X
+grep -q "scene.toml:7:[0-9]*: error: \[\[cloth\]\] .cape. drag" <<< "$ERR" ||
+    fail "the error names the drag map at the scene's line 7: $ERR"
 finish
