@@ -522,17 +522,13 @@ std::vector<uint8_t> SelfCollision::dirtySince(const std::vector<double>& before
 }
 
 bool SelfCollision::rigidZone(const std::vector<int>& members) const {
-    const Vec3* first = nullptr;
-    Vec3 d;
-    for (int i : members) {
+    // Rigid when its held vertices (if any) all share one displacement.
+    const int* first = nullptr;
+    for (const int& i : members) {
         if (mInvMass[i] != 0.0) continue;
-        const Vec3 di = vec3At(mD0.data(), i);
-        if (!first) {
-            d = di;
-            first = &d;
-        } else if ((di - d).norm() > 1e-12 * (1.0 + d.norm())) {
-            return false;
-        }
+        if (!first) first = &i;
+        const Vec3 d = vec3At(mD0.data(), *first);
+        if ((Vec3(vec3At(mD0.data(), i)) - d).norm() > 1e-12 * (1.0 + d.norm())) return false;
     }
     return true;
 }

@@ -20,10 +20,17 @@ using namespace gale::solver::testing;
 
 namespace {
 
-size_t intersections(const Body& b) {
-    const auto* tris = b.collisionTriangles();
-    const std::vector<double> x(b.positions().data(), b.positions().data() + b.positions().size());
-    return contact::intersectingPairs(x, *tris).size();
+// Intersecting triangle pairs over several bodies together (within and between them).
+size_t intersections(const std::vector<const Body*>& bodies) {
+    std::vector<double> x;
+    std::vector<std::array<int, 3>> tris;
+    for (const Body* b : bodies) {
+        const int offset = static_cast<int>(x.size() / 3);
+        x.insert(x.end(), b->positions().data(), b->positions().data() + b->positions().size());
+        for (const auto& t : *b->collisionTriangles())
+            tris.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+    return contact::intersectingPairs(x, tris).size();
 }
 
 Collider ground() {
@@ -51,7 +58,7 @@ int fallingSheet(bool selfCollision, int threads, VecX* final = nullptr) {
     for (int f = 2; f <= 49; ++f) {
         const FrameStats fs = w.advanceFrame(f);
         REQUIRE_FALSE(fs.failed);
-        const size_t pairs = intersections(*w.bodies()[0]);
+        const size_t pairs = intersections({w.bodies()[0].get()});
         if (selfCollision) {
             CHECK(fs.selfContacts.unresolved == 0);
             CHECK(fs.bodies[0].selfIntersections == static_cast<int>(pairs));
@@ -148,16 +155,7 @@ TEST_CASE("self-collision: a sheet thrown at a net at one substep per frame stay
         for (int f = 2; f <= 24; ++f) {
             const FrameStats fs = s.world->advanceFrame(f);
             REQUIRE_FALSE(fs.failed);
-            std::vector<double> x;
-            std::vector<std::array<int, 3>> tris;
-            for (Body* b : {s.net, s.falling}) {
-                const int offset = static_cast<int>(x.size() / 3);
-                x.insert(x.end(), b->positions().data(),
-                         b->positions().data() + b->positions().size());
-                for (const auto& t : *b->collisionTriangles())
-                    tris.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-            }
-            pairsFrames += !contact::intersectingPairs(x, tris).empty();
+            pairsFrames += intersections({s.net, s.falling}) > 0;
             for (size_t i = 0; i < s.falling->vertexCount(); ++i) {
                 bool under = false;
                 if (!aboveSheet(*s.net, vec3At(s.falling->positions().data(), i), under) && under)
@@ -314,15 +312,7 @@ TEST_CASE("self-collision: a start that intersects is reported and not made wors
     w.addBody(std::move(flat));
     w.addBody(std::move(wall));
     const auto startPairs = [&] {
-        std::vector<double> x;
-        std::vector<std::array<int, 3>> tris;
-        for (const auto& b : w.bodies()) {
-            const int offset = static_cast<int>(x.size() / 3);
-            x.insert(x.end(), b->positions().data(), b->positions().data() + b->positions().size());
-            for (const auto& t : *b->collisionTriangles())
-                tris.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-        }
-        return contact::intersectingPairs(x, tris).size();
+        return intersections({w.bodies()[0].get(), w.bodies()[1].get()});
     };
     const size_t at0 = startPairs();
     REQUIRE(at0 > 0);
