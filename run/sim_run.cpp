@@ -7,6 +7,8 @@
 #include "scene/load.h"
 #include "scene/scene_checks.h"
 
+#include <algorithm>
+
 namespace gale::run {
 
 RunError SimRun::load(const SimSetup& s, std::string& report) {
@@ -42,6 +44,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     }
     mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
     mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
+    mRunUpFrom = std::min(mFirst, mScene.wind.settings.frameStart);
     mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads);
     for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast))
         report += w.render() + '\n';
@@ -56,6 +59,19 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
 const std::string& SimRun::outputFormat(size_t i) const {
     return i < mScene.cloths.size() ? mScene.cloths[i].output
                                     : mScene.hairs[i - mScene.cloths.size()].output;
+}
+
+bool SimRun::runUp(const std::function<void(const solver::FrameStats&)>& each,
+                   solver::FrameStats& failed) {
+    for (int f = mRunUpFrom + 1; f <= mFirst; ++f) {
+        const solver::FrameStats stats = mWorld->advanceFrame(f);
+        if (each) each(stats);
+        if (stats.failed) {
+            failed = stats;
+            return false;
+        }
+    }
+    return true;
 }
 
 solver::FrameStats SimRun::initialFrame() const {

@@ -7,6 +7,7 @@
 #include "scene/sim_scene.h"
 #include "solver/world/world.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,6 +52,17 @@ public:
     // The output format ("obj" or "ply") of the world's body `i`.
     const std::string& outputFormat(size_t i) const;
 
+    // The frames simulated before first() and not written (the run-up): a range that starts
+    // after the scene's first frame is reached by simulating from there, so that it starts from a
+    // simulated state — the cloth where the shot took it — never from the rest mesh teleported
+    // to the bodies' pose at first(). 0 when first() is the scene's first frame (or before it).
+    int runUpFrames() const { return mFirst - mRunUpFrom; }
+    // Steps the world from the scene's first frame to first(), calling `each` after every frame
+    // (for progress and events). False, with the frame's stats in `failed`, when a frame failed
+    // numerically.
+    bool runUp(const std::function<void(const solver::FrameStats&)>& each,
+               solver::FrameStats& failed);
+
     // The stats of frame first(): the initial state, no substeps.
     solver::FrameStats initialFrame() const;
     // Advances the world from frame − 1 to `frame`.
@@ -60,6 +72,7 @@ private:
     scene::SimScene mScene;
     std::unique_ptr<solver::World> mWorld;
     int mFirst = 0, mLast = 0;
+    int mRunUpFrom = 0; // the frame the run-up starts at (its initial state)
     std::string mSettings;
 };
 

@@ -65,6 +65,17 @@ expect_match "$(head -c 400 shot/out/run.json)" '"frames": \[1001, 1012\]' "run.
 t1012=$(grep -o '"frame": 1012, "time": [^,]*' shot/out/run.json | sed 's/.*: //')
 awk -v t="$t1012" 'BEGIN { exit !(t > 0.4583 && t < 0.4584) }' || fail "frame 1012 ends at 11/24 s, got $t1012"
 
+# A range that starts mid-shot starts from the simulated state there: the frames before it are
+# simulated first, so each frame is the full run's, byte for byte (never the rest mesh
+# teleported to the body's pose at the range's first frame).
+run "$GALE" sim shot/scene.toml -o shot/late --frames 1008:1012
+expect_rc 0 "a range that starts mid-shot"
+expect_match "$ERR" "frames 1001-1008 are simulated first and not written" "the run-up is said ($ERR)"
+[ -e shot/late/sheet.1007.obj ] && fail "frames before the range are not written"
+for ((f = 1008; f <= 1012; f++)); do
+    cmp -s shot/late/sheet.$f.obj shot/out/sheet.$f.obj || fail "frame $f of --frames 1008:1012 is the full run's"
+done
+
 # $frame is the studio frame, $t the shot time.
 cat > shot/frame.se <<'EOF'
 [$frame, $t, 0]
