@@ -49,6 +49,10 @@ public:
     double fps() const { return mScene.wind.settings.fps; }
     // run.json's "settings": the scene as resolved, for this frame range and thread count.
     const std::string& settings() const { return mSettings; }
+    // A digest of what the run reads besides its settings — the scene file's text, the --set
+    // overrides, the expression files (their bytes), meshes, strands and attachment sequences
+    // (their sizes and times) — so that --resume refuses a run whose inputs changed since.
+    const std::string& inputsDigest() const { return mInputs; }
     // The output format ("obj" or "ply") of the world's body `i`.
     const std::string& outputFormat(size_t i) const;
 
@@ -74,6 +78,7 @@ private:
     int mFirst = 0, mLast = 0;
     int mRunUpFrom = 0; // the frame the run-up starts at (its initial state)
     std::string mSettings;
+    std::string mInputs;
 };
 
 } // namespace gale::run
