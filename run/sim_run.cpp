@@ -31,7 +31,8 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     }
     std::vector<std::unique_ptr<solver::Body>> bodies;
     std::vector<std::string> warnings;
-    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths))
+    mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
+    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths, mFirst))
         return sceneErrors(errors);
     for (const std::string& w : warnings) report += "gale: warning: " + w + '\n';
     if (bodies.empty()) {

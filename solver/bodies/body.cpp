@@ -32,6 +32,8 @@ constexpr int kContactRounds = 8;
 constexpr double kContactBand = 0.5;
 // A sliding contact's friction that changed by less than this fraction asks for no new solve.
 constexpr double kFrictionChange = 0.1;
+// m/s: a slip slower than this has no direction of its own.
+constexpr double kSlipSlop = 1e-6;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
 } // namespace
@@ -94,7 +96,7 @@ void Body::addPins(const PinSet& pins) {
         mPinSet.push_back(set);
         mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
                                   ? std::make_shared<const SurfaceBinding>(
-                                        bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                        bindToSurface(*pins.attach, vec3At(mX.data(), v), pins.bindTime))
                                   : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
@@ -404,9 +406,16 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             const Vec3 lt = lambda - nrm * ln;
             const double ltn = lt.norm();
             if (ltn > mu * ln * (1.0 + 1e-9) && ltn > 0.0) {
+                // Against the slip relative to the surface when the sticking motion has one
+                // (a vertex that slides onto the plane), else along the holding impulse.
+                const Vec3 rel = vec3At(mStickVelocity.data(), i) -
+                                 vec3At(mContactVelocity.data(), i);
+                const Vec3 slip = rel - nrm * rel.dot(nrm);
+                const double slipN = slip.norm();
                 mConstraints.kind[i] = 2;
                 z = nrm * z.dot(nrm);
-                fr = (mu * ln / ltn) * lt;
+                fr = slipN > kSlipSlop ? Vec3(-(mu * ln / slipN) * slip)
+                                       : Vec3((mu * ln / ltn) * lt);
                 mFrictionCap[i] = ltn;
                 ++st.contactSlides;
                 ++changes;

@@ -52,6 +52,9 @@ struct PinSet {
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
     PinRotation rotate;
     std::shared_ptr<const MeshSequence> attach;
+    // s: the time of the body's pose the attachment binds against — the first simulated frame's
+    // (the start state's) time; NaN: the sequence's first file.
+    double bindTime = NAN;
 };
 
 // Numerical settings of a body's substep.
