@@ -364,12 +364,13 @@ void Body::contactRhs(double h) {
 
 // The active set after a solve (Baraff & Witkin 1998 §5.3), from each contact's constraint
 // impulse λ = A Δv − b (N·s), normal part λ_n = λ·n:
-// - λ_n < 0 (the contact pulls): released, for the rest of the substep;
-// - sticking and |λ_t| > μ λ_n (more friction than Coulomb allows): sliding, with the friction
-//   impulse μ λ_n λ̂_t in b — the direction of the impulse that held it, a fraction μλ_n/|λ_t|
-//   < 1 of it, so it slows the slip without reversing it and cannot add energy;
-// - sliding: the friction follows μ λ_n of this solve, against the slip v_t − v_s,t; a slip
-//   that turned to run along the friction (it would push) sticks instead;
+// - λ_n < 0 (the contact pulls): released, for the rest of the substep (not a contact made
+//   because the vertex ended a solve inside);
+// - sticking and |λ_t| > μ λ_n (more friction than Coulomb allows): sliding, S = I − nnᵀ, with
+//   a friction impulse f in b against the slip v_t − v_s,t of the latest solve, lagged by one
+//   solve and bounded: |f| ≤ min(μ λ_n, |λ_t| of the stick, m |v_t − v_s,t|) — at most what
+//   would stop the vertex's own slip, so it cannot reverse a slip and add energy; a slip that
+//   turns to run along f (f overshot) halves f instead of flipping it (no chatter);
 // - a free vertex that ends the step within a collider's thickness moving in (relative to the
 //   surface) gets a contact plane from the query at its end position, at t + h (sticking when
 //   the collider has friction).
@@ -414,8 +415,10 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                 const double slipN = slip.norm();
                 mConstraints.kind[i] = 2;
                 z = nrm * z.dot(nrm);
-                fr = slipN > kSlipSlop ? Vec3(-(mu * ln / slipN) * slip)
-                                       : Vec3((mu * ln / ltn) * lt);
+                // At most what stops the slip of the vertex alone, m |v_t| (so the lagged
+                // friction cannot reverse a slip and add energy: light, stiffly coupled hair).
+                const double mag = std::min(mu * ln, mMass[i] * slipN);
+                fr = slipN > kSlipSlop ? Vec3(-(mag / slipN) * slip) : Vec3::Zero();
                 mFrictionCap[i] = ltn;
                 ++st.contactSlides;
                 ++changes;
@@ -435,7 +438,8 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             } else {
                 const Vec3 dir = slipN > 0.0 ? Vec3(-slip / slipN)
                                              : (frN > 0.0 ? Vec3(fr / frN) : Vec3::Zero());
-                const Vec3 next = std::min(std::max(mu * ln, 0.0), mFrictionCap[i]) * dir;
+                const Vec3 next =
+                    std::min({std::max(mu * ln, 0.0), mFrictionCap[i], mMass[i] * slipN}) * dir;
                 if ((next - fr).norm() > kFrictionChange * std::max(frN, mu * ln)) ++changes;
                 fr = next;
             }
