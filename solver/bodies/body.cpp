@@ -368,9 +368,9 @@ void Body::contactRhs(double h) {
 //   because the vertex ended a solve inside);
 // - sticking and |λ_t| > μ λ_n (more friction than Coulomb allows): sliding, S = I − nnᵀ, with
 //   a friction impulse f in b against the slip v_t − v_s,t of the latest solve, lagged by one
-//   solve and bounded: |f| ≤ min(μ λ_n, |λ_t| of the stick, m |v_t − v_s,t|) — at most what
-//   would stop the vertex's own slip, so it cannot reverse a slip and add energy; a slip that
-//   turns to run along f (f overshot) halves f instead of flipping it (no chatter);
+//   solve and bounded: |f| ≤ min(μ λ_n, |λ_t| of the stick) — less than what held it, so it
+//   slows the slip; a slip that turns to run along f (f overshot, it would push) halves f
+//   instead of flipping it (no chatter);
 // - a free vertex that ends the step within a collider's thickness moving in (relative to the
 //   surface) gets a contact plane from the query at its end position, at t + h (sticking when
 //   the collider has friction).
@@ -415,10 +415,8 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                 const double slipN = slip.norm();
                 mConstraints.kind[i] = 2;
                 z = nrm * z.dot(nrm);
-                // At most what stops the slip of the vertex alone, m |v_t| (so the lagged
-                // friction cannot reverse a slip and add energy: light, stiffly coupled hair).
-                const double mag = std::min(mu * ln, mMass[i] * slipN);
-                fr = slipN > kSlipSlop ? Vec3(-(mag / slipN) * slip) : Vec3::Zero();
+                fr = slipN > kSlipSlop ? Vec3(-(mu * ln / slipN) * slip)
+                                       : Vec3((mu * ln / ltn) * lt);
                 mFrictionCap[i] = ltn;
                 ++st.contactSlides;
                 ++changes;
@@ -438,8 +436,7 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             } else {
                 const Vec3 dir = slipN > 0.0 ? Vec3(-slip / slipN)
                                              : (frN > 0.0 ? Vec3(fr / frN) : Vec3::Zero());
-                const Vec3 next =
-                    std::min({std::max(mu * ln, 0.0), mFrictionCap[i], mMass[i] * slipN}) * dir;
+                const Vec3 next = std::min(std::max(mu * ln, 0.0), mFrictionCap[i]) * dir;
                 if ((next - fr).norm() > kFrictionChange * std::max(frN, mu * ln)) ++changes;
                 fr = next;
             }
