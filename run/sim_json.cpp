@@ -145,7 +145,13 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"potential\": " << num(b.potential)
           << ", \"total\": " << num(b.kinetic + b.elastic + b.potential)
           << "}, \"wind_non_finite\": " << b.windNonFinite
-          << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts;
+          << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
+          << ", \"contact_solve\": {\"constraints\": " << b.contactConstraints
+          << ", \"added\": " << b.contactAdded << ", \"released\": " << b.contactReleases
+          << ", \"slid\": " << b.contactSlides
+          << ", \"extra_solves\": " << b.contactSolves << "}, \"contact_projection\": {\"vertices\": "
+          << b.projected << ", \"max_distance\": " << num(b.projectedDistance)
+          << ", \"max_speed\": " << num(b.projectedSpeed) << "}";
         if (b.selfIntersections >= 0) o << ", \"self_intersections\": " << b.selfIntersections;
         o
           << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";

@@ -108,7 +108,12 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     }
     std::vector<std::unique_ptr<solver::Body>> bodies;
     std::vector<std::string> warnings;
-    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths))
+    mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
+    mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
+    mRunUpFrom = std::min(mFirst, mScene.wind.settings.frameStart);
+    // Attachments bind against their bodies where the simulation starts: the run-up's first
+    // frame when the range starts mid-shot (its frames are simulated first), else first().
+    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths, mRunUpFrom))
         return sceneErrors(errors);
     for (const std::string& w : warnings) report += "gale: warning: " + w + '\n';
     if (bodies.empty()) {
@@ -116,9 +121,6 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
         err.message = s.scene + ": the scene has no [[cloth]] or [[hair]] to simulate";
         return err;
     }
-    mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
-    mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
-    mRunUpFrom = std::min(mFirst, mScene.wind.settings.frameStart);
     mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads);
     mInputs = digestInputs(mScene, s.sets);
     for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast))

@@ -249,7 +249,9 @@ std::string liftAboveDragWarning(const SimScene& scene, const ClothSpec& spec,
 
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodies,
                  std::vector<SceneError>& errors, std::vector<std::string>& warnings,
-                 const std::vector<std::string>& allowPaths) {
+                 const std::vector<std::string>& allowPaths, int firstFrame) {
+    const double bindTime = scene.wind.settings.frameTime(
+        firstFrame == INT_MIN ? scene.wind.settings.frameStart : firstFrame);
     const size_t before = errors.size();
     for (const ClothSpec& spec : scene.cloths) {
         const std::string what = "[[cloth]] '" + spec.name + "'";
@@ -352,6 +354,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             PinSet att;
             std::string problem;
             att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
+            att.bindTime = bindTime;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));
@@ -421,6 +424,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         if (spec.hasAttach) {
             std::string problem;
             att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
+            att.bindTime = bindTime;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));

@@ -3,6 +3,8 @@
 // here: meshes and strands loaded, painted maps evaluated, pins resolved.
 #pragma once
 
+#include <climits>
+
 #include "fields/scene.h"
 #include "scene/error.h"
 #include "io/pointset.h"
@@ -108,9 +110,11 @@ struct SimScene {
 // the scene that named them; `warnings` gets notes such as degenerate-triangle counts. Files
 // named in painted-map expressions resolve like the wind's: inside the scene's folder or one of
 // `allowPaths` (--allow-path).
+// Attachments bind against their body at the first simulated frame's time, firstFrame / fps
+// (the start state's time; INT_MIN: the scene's first frame), whatever range the sequence covers.
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<solver::Body>>& bodies,
                  std::vector<SceneError>& errors, std::vector<std::string>& warnings,
-                 const std::vector<std::string>& allowPaths = {});
+                 const std::vector<std::string>& allowPaths = {}, int firstFrame = INT_MIN);
 
 // World settings of a scene (threads: 0 for all hardware threads).
 solver::WorldSettings worldSettings(const SimScene& scene, int threads);

@@ -25,6 +25,17 @@ constexpr int kGmresRestarts = 4;
 // A vertex this close to a collider's offset surface (m) counts as touching it: rounding
 // after a projection must not switch the contact off.
 constexpr double kContactSlop = 1e-7;
+// Solves of a substep after the first for changes of the contact set (updateContacts).
+constexpr int kContactRounds = 8;
+// A vertex touching a collider after a substep starts the next one in contact within this
+// fraction of the thickness above it (it lands on the plane during the step).
+constexpr double kContactBand = 0.5;
+// A sliding contact's friction that changed by less than this fraction asks for no new solve.
+constexpr double kFrictionChange = 0.1;
+// m/s: a slip slower than this has no direction of its own.
+constexpr double kSlipSlop = 1e-6;
+// A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
+constexpr double kProjectionSlop = 1e-6;
 } // namespace
 
 bool PaintedParam::alwaysZero() const {
@@ -72,6 +83,7 @@ void Body::finishSetup(const std::vector<std::array<int, 2>>& edges) {
             (vec3At(mRest.data(), edges[e][1]) - vec3At(mRest.data(), edges[e][0])).norm();
     mContactImpulse.assign(n, 0.0);
     mContactCollider.assign(n, -1);
+    mContactSpeed.assign(n, 0.0);
 }
 
 void Body::addPins(const PinSet& pins) {
@@ -84,7 +96,7 @@ void Body::addPins(const PinSet& pins) {
         mPinSet.push_back(set);
         mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
                                   ? std::make_shared<const SurfaceBinding>(
-                                        bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                        bindToSurface(*pins.attach, vec3At(mX.data(), v), pins.bindTime))
                                   : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
@@ -205,6 +217,50 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     }
 }
 
+// The contact plane of vertex i, made from a query cp of collider `ci` at point p and time tq
+// (t or t + h): the vertex must end the step on the offset surface n·x₁ = c, c = n·p − d + ξ
+// moved with the surface to t + h. With the gap g = c − n·x₀ − h v_s·n (how far the plane is
+// ahead of the vertex moving with the surface):
+//   g ≥ 0 (behind the plane: inside, pushed out)  y = n g,  z·n = (v_s − v₀)·n
+//   g < 0 (ahead of it, closing in)                y = 0,   z·n = (v_s − v₀)·n + g/h
+// y is Baraff & Witkin's position alteration (1998 §5.2, §6: x₁ = x₀ + h v₁ + y; the forces
+// see it, contactRhs): a push-out moves the vertex without giving it a speed. A closing vertex
+// instead lands on the plane along its own motion during the step (the elastic solve sees that
+// motion), and the impact is inelastic: its normal speed ends equal to the surface's
+// (landed()). A y along the normal for a closing vertex would move it sideways in the sheet's
+// plane on a curved collider, a strain its free neighbours do not share.
+// A sticking contact (`stick`) is a full constraint, S = 0: the vertex follows its own motion
+// relative to the surface, u = v − v_s (`path`: the vertex's velocity without the contact),
+// until it meets the plane, at the fraction s = g/(h u·n) of the step, and then moves with the
+// surface: v₁ = v_s + s u over the step (v_s when it is not closing in), and v_s at its end
+// (landed()). A sliding one keeps S = I − nnᵀ and gets its friction in the right-hand side
+// (updateContacts).
+void Body::setContact(size_t i, int ci, const ContactPoint& cp, const Vec3& p, double tq,
+                      double thick, double t1, double h, const VecX& xStart, const VecX& vStart,
+                      const Vec3& path, bool stick) {
+    const Vec3 nrm = cp.normal;
+    const double vsn = cp.velocity.dot(nrm);
+    const double c = nrm.dot(p) - cp.distance + thick + (t1 - tq) * vsn;
+    const Vec3 x0 = vec3At(xStart.data(), i), v0 = vec3At(vStart.data(), i);
+    const double gap = c - nrm.dot(x0) - h * vsn;
+    const Vec3 u = path - cp.velocity;
+    const double un = u.dot(nrm);
+    Vec3 vStick = cp.velocity;
+    if (gap < 0.0)
+        vStick += un < 0.0 && gap > h * un ? Vec3((gap / (h * un)) * u) : Vec3(nrm * (gap / h));
+    vec3At(mStickVelocity.data(), i) = vStick;
+    const Vec3 z = vStick - v0;
+    mConstraints.kind[i] = stick ? 1 : 2;
+    vec3At(mConstraints.normal.data(), i) = nrm;
+    vec3At(mConstraints.z.data(), i) = stick ? z : Vec3(nrm * z.dot(nrm));
+    vec3At(mYPos.data(), i) = nrm * std::max(gap, 0.0);
+    vec3At(mFriction.data(), i).setZero();
+    vec3At(mContactVelocity.data(), i) = cp.velocity;
+    mContactSpeed[i] = vsn;
+    mContactCollider[i] = ci;
+    mContactMu[i] = 0.0;
+}
+
 void Body::evaluateKinematics(const Environment& env, double t, double h) {
     mKin.t0 = t;
     mKin.t1 = t + h;
@@ -230,35 +286,187 @@ void Body::evaluateKinematics(const Environment& env, double t, double h) {
     }
 }
 
-void Body::contactConstraints(const Environment& env, double h) {
+void Body::contactConstraints(const Environment& env, double t, double h) {
+    const size_t n = vertexCount();
     std::fill(mContactImpulse.begin(), mContactImpulse.end(), 0.0);
     std::fill(mContactCollider.begin(), mContactCollider.end(), -1);
+    mReleased.assign(n, 0);
+    mFriction.setZero(3 * n);
+    mContactVelocity.setZero(3 * n);
+    mStickVelocity.setZero(3 * n);
+    mContactMu.assign(n, 0.0);
+    mFoundInside.assign(n, 0);
+    mFrictionCap.assign(n, std::numeric_limits<double>::infinity());
     if (!env.colliders || env.colliders->empty()) return;
-    const size_t n = vertexCount();
     for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
+        const Collider& c = (*env.colliders)[ci];
         const double thick = mKin.colliders[ci].thickness;
         const ColliderPose& pose = mKin.colliders[ci].start;
         for (size_t i = 0; i < n; ++i) {
-            if (mConstraints.kind[i] == 1) continue; // pinned or held
+            if (mConstraints.kind[i] != 0) continue; // pinned, held, or another collider's
             const Vec3 x = vec3At(mX.data(), i);
             const ContactPoint cp = queryCollider(pose, x);
-            if (!(cp.distance < thick + kContactSlop)) continue;
+            // Touching at the end of the last substep: within a band above the thickness (a
+            // vertex that slid over a curved surface lifts off its tangent plane a little).
+            const bool touched = i < mTouching.size() && mTouching[i];
+            const double band = touched ? kContactBand * thick + kContactSlop : kContactSlop;
+            if (!(cp.distance < thick + band)) continue;
             // Predicted normal speed relative to the surface without the constraint: keep
-            // the vertex on the surface only if it would move in (no adhesion).
+            // the vertex on the surface only if it would move in (no adhesion). The solve
+            // corrects the guess: updateContacts() releases it if its force pulls.
             const Vec3 v0 = vec3At(mV.data(), i);
             const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - cp.velocity;
             const double un = pred.dot(cp.normal);
             if (!(un < 0.0)) continue;
-            mConstraints.kind[i] = 2;
-            vec3At(mConstraints.normal.data(), i) = cp.normal;
-            vec3At(mConstraints.z.data(), i) = cp.normal * (cp.velocity - v0).dot(cp.normal);
+            setContact(i, static_cast<int>(ci), cp, x, t, thick, t + h, h, mX, mV, v0,
+                       c.friction > 0.0);
+            mContactMu[i] = c.friction;
             mContactImpulse[i] = -un;
-            mContactCollider[i] = static_cast<int>(ci);
         }
     }
 }
 
-int Body::resolveContacts(const Environment& env, double h) {
+// The inelastic impact of the contacts that closed in during the step (setContact): the normal
+// speed relative to the surface, which carried the vertex onto the plane, ends at zero.
+void Body::landed() {
+    for (size_t i = 0; i < vertexCount(); ++i) {
+        if (mContactCollider[i] < 0) continue;
+        const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+        Eigen::Map<Vec3> v(mV.data() + 3 * i);
+        const double removed = v.dot(nrm) - mContactSpeed[i];
+        if (mConstraints.kind[i] == 1) v = vec3At(mContactVelocity.data(), i); // stuck
+        else v -= nrm * removed;
+        mContactImpulse[i] += std::max(0.0, -removed);
+    }
+}
+
+// The right-hand side with the contacts: their friction impulses, and the position alteration
+// seen by the forces at the end of the step, x₀ + h v₁ + y, so b = h (f₀ − h K v₀) − (hD + h²K)
+// y / h (Baraff & Witkin 1998, eq. 18; the damping sees y as the velocity y/h it moves with
+// during the step). (A − M) y = (hD + h²K) y.
+void Body::contactRhs(double h) {
+    mBc = mB;
+    bool any = false, anyY = false;
+    for (size_t i = 0; i < vertexCount(); ++i)
+        if (mContactCollider[i] >= 0) {
+            any = true;
+            anyY = anyY || vec3At(mYPos.data(), i).squaredNorm() > 0.0;
+        }
+    if (!any) return;
+    mBc += mFriction;
+    if (!anyY) return;
+    mTmp.resize(mB.size());
+    mA.multiply(mYPos.data(), mTmp.data());
+    for (size_t i = 0; i < vertexCount(); ++i)
+        mTmp.segment<3>(3 * i) -= mMass[i] * mYPos.segment<3>(3 * i);
+    mBc -= mTmp / h;
+}
+
+// The active set after a solve (Baraff & Witkin 1998 §5.3), from each contact's constraint
+// impulse λ = A Δv − b (N·s), normal part λ_n = λ·n:
+// - λ_n < 0 (the contact pulls): released, for the rest of the substep (not a contact made
+//   because the vertex ended a solve inside);
+// - sticking and |λ_t| > μ λ_n (more friction than Coulomb allows): sliding, S = I − nnᵀ, with
+//   a friction impulse f in b against the slip v_t − v_s,t of the latest solve, lagged by one
+//   solve and bounded: |f| ≤ min(μ λ_n, |λ_t| of the stick) — less than what held it, so it
+//   slows the slip; a slip that turns to run along f (f overshot, it would push) halves f
+//   instead of flipping it (no chatter);
+// - a free vertex that ends the step within a collider's thickness moving in (relative to the
+//   surface) gets a contact plane from the query at its end position, at t + h (sticking when
+//   the collider has friction).
+// Returns the number of changes (each asks for another solve).
+int Body::updateContacts(const Environment& env, double t, double h, const VecX& x0,
+                         const VecX& v0, SubstepStatus& st) {
+    if (!env.colliders || env.colliders->empty()) return 0;
+    const size_t n = vertexCount();
+    int changes = 0;
+    mTmp.resize(3 * n);
+    mA.multiply(mDv.data(), mTmp.data());
+    mTmp -= mBc;
+    for (size_t i = 0; i < n; ++i) {
+        if (mContactCollider[i] < 0) continue;
+        const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+        const Vec3 lambda = vec3At(mTmp.data(), i);
+        const double ln = lambda.dot(nrm); // N·s
+        Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
+        Eigen::Map<Vec3> fr(mFriction.data() + 3 * i);
+        if (ln < 0.0 && !mFoundInside[i]) {
+            mConstraints.kind[i] = 0;
+            z.setZero();
+            fr.setZero();
+            vec3At(mYPos.data(), i).setZero();
+            mContactCollider[i] = -1;
+            mContactImpulse[i] = 0.0;
+            mReleased[i] = 1;
+            ++st.contactReleases;
+            ++changes;
+            continue;
+        }
+        const double mu = mContactMu[i];
+        if (mConstraints.kind[i] == 1) { // sticking
+            const Vec3 lt = lambda - nrm * ln;
+            const double ltn = lt.norm();
+            if (ltn > mu * ln * (1.0 + 1e-9) && ltn > 0.0) {
+                // Against the slip relative to the surface when the sticking motion has one
+                // (a vertex that slides onto the plane), else along the holding impulse.
+                const Vec3 rel = vec3At(mStickVelocity.data(), i) -
+                                 vec3At(mContactVelocity.data(), i);
+                const Vec3 slip = rel - nrm * rel.dot(nrm);
+                const double slipN = slip.norm();
+                mConstraints.kind[i] = 2;
+                z = nrm * z.dot(nrm);
+                fr = slipN > kSlipSlop ? Vec3(-(mu * ln / slipN) * slip)
+                                       : Vec3((mu * ln / ltn) * lt);
+                mFrictionCap[i] = ltn;
+                ++st.contactSlides;
+                ++changes;
+            }
+        } else if (mu > 0.0) { // sliding
+            const Vec3 rel = vec3At(v0.data(), i) + vec3At(mDv.data(), i) -
+                             vec3At(mContactVelocity.data(), i);
+            const Vec3 slip = rel - nrm * rel.dot(nrm);
+            const double slipN = slip.norm();
+            const double frN = fr.norm();
+            if (frN > 0.0 && slip.dot(fr) > 0.0) {
+                // The slip turned to run along the friction: it overshot the sticking impulse
+                // (which lies between 0 and fr). Halve it rather than flip it (no chatter).
+                fr *= 0.5;
+                mFrictionCap[i] = fr.norm();
+                ++changes;
+            } else {
+                const Vec3 dir = slipN > 0.0 ? Vec3(-slip / slipN)
+                                             : (frN > 0.0 ? Vec3(fr / frN) : Vec3::Zero());
+                const Vec3 next = std::min(std::max(mu * ln, 0.0), mFrictionCap[i]) * dir;
+                if ((next - fr).norm() > kFrictionChange * std::max(frN, mu * ln)) ++changes;
+                fr = next;
+            }
+        }
+    }
+    const double t1 = t + h;
+    for (size_t k = 0; k < mKin.colliders.size(); ++k) {
+        const Collider& c = (*env.colliders)[k];
+        const double thick = mKin.colliders[k].thickness;
+        const ColliderPose& pose = mKin.colliders[k].end;
+        const int ci = static_cast<int>(k);
+        for (size_t i = 0; i < n; ++i) {
+            if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
+            const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
+            const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
+            const ContactPoint cp = queryCollider(pose, x1);
+            if (!(cp.distance < thick - kContactSlop)) continue;
+            if (!((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
+            setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, c.friction > 0.0);
+            mContactMu[i] = c.friction;
+            mContactImpulse[i] = -(v1 - cp.velocity).dot(cp.normal); // the approach it had
+            mFoundInside[i] = 1;
+            ++st.contactAdded;
+            ++changes;
+        }
+    }
+    return changes;
+}
+
+int Body::resolveContacts(const Environment& env, double h, SubstepStatus& st) {
     if (!env.colliders || env.colliders->empty()) {
         mTouching.clear();
         return 0;
@@ -270,14 +478,15 @@ int Body::resolveContacts(const Environment& env, double h) {
         const double thick = mKin.colliders[ci].thickness;
         const ColliderPose& pose = mKin.colliders[ci].end;
         for (size_t i = 0; i < n; ++i) {
-            if (mConstraints.kind[i] == 1) continue;
+            if (mConstraints.kind[i] == 1 && mContactCollider[i] < 0) continue; // pin or held
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
             const ContactPoint cp = queryCollider(pose, x);
             const bool held = mContactCollider[i] == static_cast<int>(ci);
             if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
             if (!(cp.distance < thick) && !held) continue;
             touched[i] = 1;
-            if (cp.distance < thick) x += (thick - cp.distance) * cp.normal;
+            const double push = cp.distance < thick ? thick - cp.distance : 0.0;
+            if (push > 0.0) x += push * cp.normal;
             Eigen::Map<Vec3> v(mV.data() + 3 * i);
             Vec3 rel = v - cp.velocity;
             double impulse = mContactImpulse[i]; // m/s removed by the constraint in the solve
@@ -286,11 +495,19 @@ int Body::resolveContacts(const Environment& env, double h) {
                 rel -= vn * cp.normal;
                 impulse += -vn;
             }
-            // Coulomb friction: the tangential speed drops by at most μ × the normal impulse.
+            // What the solve left for this projection (reported; none where the solve's
+            // contact planes held): a push-out beyond rounding, or an approach speed removed.
+            if (push > kProjectionSlop || -vn > kProjectionSlop / h) {
+                ++st.projected;
+                st.projectedDistance = std::max(st.projectedDistance, push);
+                st.projectedSpeed = std::max(st.projectedSpeed, std::max(0.0, -vn));
+            }
+            // Coulomb friction: the tangential speed drops by at most μ × the normal impulse
+            // (a contact of the solve had its friction there).
             const Vec3 vt = rel - rel.dot(cp.normal) * cp.normal;
             const double vtn = vt.norm();
             Vec3 slip = Vec3::Zero();
-            if (vtn > 0.0) {
+            if (vtn > 0.0 && !held) {
                 const double keep = std::max(0.0, 1.0 - c.friction * impulse / vtn);
                 slip = (1.0 - keep) * vt;
                 rel -= slip;
@@ -477,7 +694,7 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
                         ForceOutput& out, const Vec3& gravity, bool withMatrix) {
     const size_t n = vertexCount();
     mV = v0 + dv;
-    mX = x0 + h * mV;
+    mX = x0 + h * mV + mYPos;
     in.x = mX.data();
     in.v = mV.data();
     assemble(in, out, gravity, withMatrix);
@@ -566,7 +783,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
     const VecX dvLin = mDv;
     elasticAt(x0, t1, mFel);
     mGk = mF0 - mFel;
-    VecX trialX = x0 + h * v0;
+    VecX trialX = x0 + h * v0 + mYPos;
     double energy = elasticAt(trialX, t1, mFel);
     VecX dvBase = VecX::Zero(3 * n);
     const double phi0 = phi(dvBase, energy, dvBase);
@@ -576,7 +793,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
     int cuts = 0;
     for (;; ++cuts) {
         mDv = alpha * dvLin;
-        trialX = x0 + h * (v0 + mDv);
+        trialX = x0 + h * (v0 + mDv) + mYPos;
         const double eTrial = elasticAt(trialX, t1, fElTrial);
         phiTrial = phi(mDv, eTrial, dvBase);
         const bool ok = slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
@@ -587,7 +804,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         }
         if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
             mDv = dvBase;
-            energy = elasticAt(x0 + h * v0, t1, mFel);
+            energy = elasticAt(x0 + h * v0 + mYPos, t1, mFel);
             break;
         }
         alpha *= 0.5;
@@ -620,7 +837,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         bool accepted = false;
         for (cuts = 0; cuts <= kMaxCuts; ++cuts, alpha *= 0.5) {
             mDv = dvBase + alpha * delta;
-            trialX = x0 + h * (v0 + mDv);
+            trialX = x0 + h * (v0 + mDv) + mYPos;
             const double eTrial = elasticAt(trialX, t1, fElTrial);
             phiTrial = phi(mDv, eTrial, dvBase);
             bool ok = std::isfinite(phiTrial) &&
@@ -756,6 +973,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
 
     // 3. Constraints: pins reach their target at t + h; held vertices stay; contacts.
     mConstraints.reset(n);
+    mYPos.setZero(3 * n);
     double pinSpeed = 0.0;
     for (size_t k = 0; k < mPinned.size(); ++k) {
         const int i = mPinned[k];
@@ -769,7 +987,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             mConstraints.kind[i] = 1;
             vec3At(mConstraints.z.data(), i) = -vec3At(v0.data(), i);
         }
-    contactConstraints(env, h);
+    contactConstraints(env, t, h);
 
     // 4. Solve, warm-started from the previous substep's Δv scaled to this step.
     SolveStatus ls;
@@ -794,8 +1012,23 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         else
             mDv.setZero(3 * n);
         mSolver.setPreconditioner(mOptions.preconditioner);
-        ls = solveLinear(mB, mDv);
+        contactRhs(h);
+        ls = solveLinear(mBc, mDv);
+        // The contact active set: release what pulls, add what ends the step inside, solve
+        // again from the last Δv (at most kContactRounds further solves).
+        for (int round = 0; round < kContactRounds && ls.converged && !ls.failed; ++round) {
+            if (updateContacts(env, t, h, x0, v0, st) == 0) break;
+            contactRhs(h);
+            const int before = ls.iterations;
+            const double res = ls.residual;
+            ls = solveLinear(mBc, mDv);
+            ls.iterations += before;
+            ls.residual = std::max(ls.residual, res);
+            ++st.contactSolves;
+        }
     }
+    for (size_t i = 0; i < n; ++i)
+        if (mContactCollider[i] >= 0) ++st.contactConstraints;
     st.iterations = ls.iterations;
     st.residual = ls.residual;
     st.converged = ls.converged && !ls.failed;
@@ -806,7 +1039,8 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     mDvGuess = mDv;
     mHGuess = h;
     mV = v0 + mDv;
-    mX = x0 + h * mV;
+    mX = x0 + h * mV + mYPos;
+    landed();
 
     // 6. Colliders: moving meshes first swept continuously over the step (no vertex or edge
     // crosses the surface, moving_collider.h), then push out, approach speed, Coulomb friction.
@@ -814,10 +1048,12 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         for (const Collider& c : *env.colliders)
             if (c.moving) {
                 std::vector<uint8_t> movable(n);
-                for (size_t i = 0; i < n; ++i) movable[i] = mConstraints.kind[i] != 1;
-                c.moving->sweep(x0, mX, mV, movable, mEdges, colliderThickness(c), c.friction, h);
+                for (size_t i = 0; i < n; ++i)
+                    movable[i] = mConstraints.kind[i] != 1 || mContactCollider[i] >= 0;
+                st.projected += c.moving->sweep(x0, mX, mV, movable, mEdges,
+                                                colliderThickness(c), c.friction, h);
             }
-    st.contacts = resolveContacts(env, h);
+    st.contacts = resolveContacts(env, h, st);
 
     // 7. Trouble detection.
     double maxSpeed = 0.0, maxJump = 0.0, maxSpeed0 = 0.0;
@@ -827,7 +1063,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             if (mHeld[i]) continue;
             maxSpeed = std::max(maxSpeed, vec3At(mV.data(), i).norm());
             maxSpeed0 = std::max(maxSpeed0, vec3At(v0.data(), i).norm());
-            if (mConstraints.kind[i] != 1)
+            if (mConstraints.kind[i] != 1 || mContactCollider[i] >= 0)
                 maxJump = std::max(maxJump, (vec3At(mV.data(), i) - vec3At(v0.data(), i)).norm());
         }
     st.maxSpeed = maxSpeed;

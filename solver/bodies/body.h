@@ -52,6 +52,9 @@ struct PinSet {
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
     PinRotation rotate;
     std::shared_ptr<const MeshSequence> attach;
+    // s: the time of the body's pose the attachment binds against — the first simulated frame's
+    // (the start state's) time; NaN: the sequence's first file.
+    double bindTime = NAN;
 };
 
 // Numerical settings of a body's substep.
@@ -120,6 +123,14 @@ struct SubstepStatus {
     double maxSpeed = 0.0;    // m/s after the step
     double maxStretch = 0.0;  // largest edge length / rest length after the step
     int contacts = 0;         // vertices touching a collider after the step
+    // Collider contact in the solve: constraints at the end, added after a solve (ended
+    // inside), released (their force pulled), extra solves for those changes; and what the
+    // projection after the solve still had to do: vertices it moved or stopped, the largest
+    // push-out (m) and the largest approach speed it removed (m/s).
+    int contactConstraints = 0, contactAdded = 0, contactReleases = 0, contactSolves = 0;
+    int contactSlides = 0; // sticking contacts that turned to slide (friction at μ λ_n)
+    int projected = 0;
+    double projectedDistance = 0.0, projectedSpeed = 0.0;
 };
 
 // Limits of the trouble detectors.
@@ -261,8 +272,15 @@ private:
     }
     // Everything scripted for the substep [t, t + h] into mKin (kinematics.h), once.
     void evaluateKinematics(const Environment& env, double t, double h);
-    void contactConstraints(const Environment& env, double h);
-    int resolveContacts(const Environment& env, double h);
+    void contactConstraints(const Environment& env, double t, double h);
+    void setContact(size_t i, int collider, const ContactPoint& cp, const Vec3& p, double tq,
+                    double thick, double t1, double h, const VecX& x0, const VecX& v0,
+                    const Vec3& path, bool stick);
+    void contactRhs(double h);
+    void landed();
+    int updateContacts(const Environment& env, double t, double h, const VecX& x0,
+                       const VecX& v0, SubstepStatus& st);
+    int resolveContacts(const Environment& env, double h, SubstepStatus& st);
     void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
                   bool withMatrix = true);
     // The filtered backward-Euler residual g at Δv into mG (mX, mV, mF, and A when asked, left
@@ -298,6 +316,16 @@ private:
     std::vector<double> mContactImpulse; // per vertex: suppressed normal speed (m/s)
     std::vector<int> mContactCollider;   // per vertex: collider holding it in the solve, or -1
     std::vector<uint8_t> mTouching;      // per vertex: touching a collider after the substep
+    std::vector<double> mContactSpeed;   // per vertex: the surface's normal speed (m/s)
+    std::vector<double> mContactMu;      // per vertex: the holding collider's friction μ
+    VecX mFriction;        // 3 per vertex: a sliding contact's friction impulse (N·s), in b
+    VecX mContactVelocity; // 3 per vertex: the surface velocity at the contact (m/s)
+    VecX mStickVelocity;   // 3 per vertex: a sticking contact's velocity over the step (m/s)
+    std::vector<uint8_t> mReleased;      // per vertex: contact released in this substep
+    std::vector<uint8_t> mFoundInside;   // per vertex: its contact came from ending inside
+    std::vector<double> mFrictionCap;    // per vertex: the most friction a slide may get (N·s)
+    VecX mYPos; // 3 per vertex: the position alteration y of the contacts (x₁ = x₀ + h v₁ + y)
+    VecX mBc, mTmp; // the right-hand side with y's term; scratch
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere

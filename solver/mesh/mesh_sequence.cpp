@@ -126,10 +126,16 @@ Mat3 triangleFrame(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 } // namespace
 
-SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x) {
+SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double when) {
     SurfaceBinding b;
     double best = INFINITY;
-    const std::vector<double>& p = mesh.firstPositions();
+    std::vector<double> at;
+    if (std::isfinite(when)) {
+        const size_t nv = mesh.firstPositions().size() / 3;
+        at.resize(3 * nv);
+        for (size_t v = 0; v < nv; ++v) vec3At(at.data(), v) = mesh.vertexAt(static_cast<int>(v), when);
+    }
+    const std::vector<double>& p = std::isfinite(when) ? at : mesh.firstPositions();
     for (size_t k = 0; k < mesh.triangles().size(); ++k) {
         const auto& t = mesh.triangles()[k];
         double w[3];

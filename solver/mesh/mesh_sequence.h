@@ -4,6 +4,8 @@
 // after the last. A plain file name is a one-frame (static) sequence.
 #pragma once
 
+#include <cmath>
+
 #include "solver/linalg/types.h"
 
 #include <array>
@@ -63,7 +65,9 @@ struct SurfaceBinding {
     double w[3] = {0, 0, 0};
     Vec3 local = Vec3::Zero();
 };
-SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x);
+// `t` (s): the time of the pose it binds against, the body interpolated there (NaN: the
+// sequence's first file).
+SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double t = NAN);
 Vec3 boundPosition(const MeshSequence& mesh, const SurfaceBinding& b, double t);
 
 } // namespace gale::solver

@@ -272,6 +272,14 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         }
         tick += ticksPerBase >> level;
         stats.contacts = st.contacts;
+        stats.contactConstraints += st.contactConstraints;
+        stats.contactAdded += st.contactAdded;
+        stats.contactReleases += st.contactReleases;
+        stats.contactSlides += st.contactSlides;
+        stats.contactSolves += st.contactSolves;
+        stats.projected += st.projected;
+        stats.projectedDistance = std::max(stats.projectedDistance, st.projectedDistance);
+        stats.projectedSpeed = std::max(stats.projectedSpeed, st.projectedSpeed);
         ++stats.substeps;
         ++index;
     }

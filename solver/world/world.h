@@ -47,6 +47,14 @@ struct BodyFrameStats {
     size_t windNonFinite = 0;
     int clampedJacobians = 0;
     int contacts = 0; // vertices touching colliders at the end of the frame
+    // Collider contact in the solve, summed over the frame's accepted substeps (SubstepStatus):
+    // contact constraints, added after a solve, released, extra solves; and the projection
+    // after the solve: vertices it still moved or stopped, its largest push-out (m) and the
+    // largest approach speed it removed (m/s).
+    long contactConstraints = 0;
+    int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
+        projected = 0;
+    double projectedDistance = 0.0, projectedSpeed = 0.0;
     // Intersecting triangle pairs with a triangle of this body at the end of the frame, counted
     // when it takes part in cloth–cloth collision (−1: not counted).
     int selfIntersections = -1;

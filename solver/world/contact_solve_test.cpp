@@ -1,0 +1,252 @@
+// Collider contact inside the implicit step (body.cpp, contact constraints): a sheet dropped
+// flat onto a sphere and edge-first onto the ground at one substep per frame against the same
+// scene at sixteen (stretch, kinetic energy after the impact, no halving, nothing left for the
+// projection after the solve), and a sheet at rest on the floor that loses energy every frame.
+#include "solver/bodies/cloth.h"
+#include "solver/collider/collider.h"
+#include "solver/world/world.h"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+
+using namespace gale::solver;
+using gale::fields::Param;
+
+namespace {
+
+enum class Drop { FlatOnSphere, EdgeOnGround };
+
+// The issue's scenes: a 0.5 m sheet, 24 × 24 vertices, 0.1 kg/m², 2000 N/m, no wind, dropped
+// from 0.25 m (flat, over a sphere of radius 0.15 m at the origin; or hanging vertically, its
+// lower edge 0.25 m above the ground plane y = 0).
+std::unique_ptr<World> dropScene(Drop d, int substeps) {
+    ClothMaterial m;
+    m.density = 0.1;
+    m.stretch = Param(2000.0);
+    m.lift.value = Param(0.0);
+    m.drag.value = Param(0.0);
+    TriMesh mesh =
+        d == Drop::FlatOnSphere
+            ? makeGrid(0.5, 0.5, 24, 24, Vec3(-0.25, 0.25, -0.25), Vec3::UnitX(), Vec3::UnitZ())
+            : makeGrid(0.5, 0.5, 24, 24, Vec3(-0.25, 0.25, 0.0), Vec3::UnitX(), Vec3::UnitY());
+    WorldSettings ws;
+    ws.substeps = substeps;
+    auto w = std::make_unique<World>(ws);
+    w->addBody(std::make_unique<Cloth>("sheet", mesh, m));
+    if (const char* nt = std::getenv("GALE_PROBE_NEWTON")) {
+        w->body(0).options().newtonIterations = std::atoi(nt);
+        w->body(0).options().newtonFullJacobian = false;
+    }
+    Collider c;
+    c.a = Param(std::vector<double>{0, 0, 0});
+    if (d == Drop::FlatOnSphere) {
+        c.shape = ColliderShape::Sphere;
+        c.radius = 0.15;
+    } else {
+        c.shape = ColliderShape::Plane;
+        c.normal = Param(std::vector<double>{0, 1, 0});
+    }
+    w->addCollider(c);
+    return w;
+}
+
+struct DropRun {
+    double maxStretch = 0.0; // over all frames
+    std::vector<double> ke;  // J: kinetic energy at the end of each frame
+    int firstContact = -1;   // the first frame that ends with contacts
+    int rejected = 0, newtonRetries = 0, recovered = 0;
+    int projected = 0; // vertices the projection after the solve still moved or stopped
+    double projectedDistance = 0.0; // m: its largest push-out
+};
+
+DropRun runDrop(Drop d, int substeps, int frames = 48, bool print = false) {
+    auto w = dropScene(d, substeps);
+    DropRun r;
+    for (int f = 1; f <= frames; ++f) {
+        const FrameStats fs = w->advanceFrame(f);
+        const BodyFrameStats& b = fs.bodies[0];
+        r.maxStretch = std::max(r.maxStretch, b.maxStretch);
+        r.ke.push_back(b.kinetic);
+        if (r.firstContact < 0 && b.contacts > 0) r.firstContact = f;
+        r.rejected += b.rejected;
+        r.newtonRetries += b.newtonRetries;
+        r.recovered += b.recovered;
+        r.projected += b.projected;
+        r.projectedDistance = std::max(r.projectedDistance, b.projectedDistance);
+        if (print)
+            std::printf("frame %2d substeps %3d rejected %d retries %d stretch %.4f ke %.3e "
+                        "elastic %.3e contacts %d vmax %.4f | c %ld add %d rel %d slides %d "
+                        "solves %d proj %d %.2e m %.2e m/s it %ld\n",
+                        f, b.substeps, b.rejected, b.newtonRetries, b.maxStretch, b.kinetic,
+                        b.elastic, b.contacts, b.maxSpeed, b.contactConstraints, b.contactAdded,
+                        b.contactReleases, b.contactSlides, b.contactSolves, b.projected,
+                        b.projectedDistance, b.projectedSpeed, b.iterations);
+    }
+    return r;
+}
+
+// The goals of issue 25 against the 16-substep run of the same scene, computed here: the strain
+// (stretch − 1) at most 1.5× the reference's plus 1 %, the kinetic energy after the impact at
+// most 1.2× plus 1 mJ, no halving, no Newton retry, and no push-out left for the projection.
+void checkAgainstReference(Drop d, bool goal) {
+    const DropRun fine = runDrop(d, 16);
+    const DropRun coarse = runDrop(d, 1);
+    // After the impact: from the frame after both runs first end a frame in contact.
+    const size_t from = static_cast<size_t>(std::max(fine.firstContact, coarse.firstContact));
+    double keFine = 0.0, keCoarse = 0.0;
+    for (size_t f = from; f < fine.ke.size(); ++f) {
+        keFine = std::max(keFine, fine.ke[f]);
+        keCoarse = std::max(keCoarse, coarse.ke[f]);
+    }
+    INFO("16 substeps: stretch " << fine.maxStretch << ", kinetic after impact " << keFine
+                                 << " J; 1 substep: stretch " << coarse.maxStretch << ", kinetic "
+                                 << keCoarse << " J, projected " << coarse.projected
+                                 << " (largest push-out " << coarse.projectedDistance << " m)");
+    REQUIRE(fine.firstContact > 0);
+    REQUIRE(coarse.firstContact > 0);
+    CHECK(fine.rejected == 0);
+    CHECK(coarse.rejected == 0);
+    CHECK(coarse.newtonRetries == 0);
+    CHECK(coarse.recovered == 0);
+    CHECK(keCoarse <= 1.2 * keFine + 1e-3);
+    // What the projection after the solve still pushes out: the goal is nothing (rounding,
+    // 1 µm); held here to a tenth of the collider's thickness (5 mm).
+    CHECK(coarse.projectedDistance <= (goal ? 1e-6 : 5e-4));
+    if (goal) CHECK(coarse.maxStretch - 1.0 <= 1.5 * (fine.maxStretch - 1.0) + 0.01);
+}
+
+} // namespace
+
+TEST_CASE("contact in the solve: a sheet dropped edge-first onto the ground at one substep "
+          "per frame",
+          "[contact]") {
+    checkAgainstReference(Drop::EdgeOnGround, false);
+}
+
+TEST_CASE("contact in the solve: the edge-first drop's goals", "[.goal][contact]") {
+    checkAgainstReference(Drop::EdgeOnGround, true);
+}
+
+TEST_CASE("contact in the solve: a sheet dropped flat onto a sphere at one substep per frame",
+          "[contact]") {
+    checkAgainstReference(Drop::FlatOnSphere, false);
+}
+
+// Not met yet (issue 25): the strain at one substep per frame is 0.068 against 1.5 × 0.013 + 0.01
+// allowed, and the projection still pushes out up to 0.2 mm; the linearised membrane has no
+// out-of-plane stiffness at a flat start, so the vertices next to the first contacts fall past
+// them within the step.
+TEST_CASE("contact in the solve: the sphere drop's stretch goal", "[.goal][contact]") {
+    checkAgainstReference(Drop::FlatOnSphere, true);
+}
+
+TEST_CASE("contact in the solve: a sheet resting on the floor comes to rest", "[contact]") {
+    // A 0.5 m sheet laid on the ground plane at the collider's thickness, one substep per frame:
+    // its kinetic energy falls every frame (no jitter) and every vertex is below 1 mm/s after
+    // 1 s.
+    ClothMaterial m;
+    m.lift.value = Param(0.0);
+    m.drag.value = Param(0.0);
+    Collider c;
+    c.a = Param(std::vector<double>{0, 0, 0});
+    c.normal = Param(std::vector<double>{0, 1, 0});
+    TriMesh mesh = makeGrid(0.5, 0.5, 24, 24, Vec3(-0.25, c.thickness + 0.002, -0.25),
+                            Vec3::UnitX(), Vec3::UnitZ());
+    for (int substeps : {1, 4}) {
+        WorldSettings ws;
+        ws.substeps = substeps;
+        World w(ws);
+        w.addBody(std::make_unique<Cloth>("sheet", mesh, m));
+        w.addCollider(c);
+        double keBefore = 0.0;
+        for (int f = 1; f <= 48; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            const BodyFrameStats& b = fs.bodies[0];
+            INFO("substeps " << substeps << " frame " << f << " kinetic " << b.kinetic
+                             << " max speed " << b.maxSpeed);
+            CHECK(b.rejected == 0);
+            if (f > 2) CHECK(b.kinetic <= keBefore);
+            if (f >= 24) CHECK(b.maxSpeed < 1e-3);
+            double low = 1e9;
+            const VecX& x = w.bodies()[0]->positions();
+            for (size_t i = 0; i < w.bodies()[0]->vertexCount(); ++i)
+                low = std::min(low, x[3 * i + 1]);
+            CHECK(low >= c.thickness - 1e-9);
+            keBefore = b.kinetic;
+        }
+    }
+}
+
+TEST_CASE("contact probe: the drop scenes frame by frame", "[.probe]") {
+    const char* s = std::getenv("GALE_PROBE_SUBSTEPS");
+    const char* d = std::getenv("GALE_PROBE_SCENE");
+    runDrop(d && d[0] == '1' ? Drop::EdgeOnGround : Drop::FlatOnSphere, s ? std::atoi(s) : 1, 48,
+            true);
+}
+
+TEST_CASE("contact in the solve: Coulomb friction on an incline at one substep per frame",
+          "[contact]") {
+    // A 10 cm patch at rest on a plane tilted by θ, friction in the solve, h = 1/24 s: it sticks
+    // when tan θ < μ, else it slides with a = g (sin θ − μ cos θ) (closed form, within 2 %),
+    // staying on the plane.
+    const double g = 9.81, T = 1.0;
+    for (double thetaDeg : {20.0, 30.0}) {
+        const double theta = thetaDeg * M_PI / 180.0;
+        const Vec3 normal(-std::sin(theta), std::cos(theta), 0.0);
+        const Vec3 down(-std::cos(theta), -std::sin(theta), 0.0); // along the slope, downhill
+        for (double mu : {0.2, 0.3, 0.5}) {
+            Collider plane;
+            plane.a = Param(std::vector<double>{0, 0, 0});
+            plane.normal = Param(std::vector<double>{normal.x(), normal.y(), normal.z()});
+            plane.friction = mu;
+            plane.thickness = 0.0;
+            TriMesh mesh = makeGrid(0.1, 0.1, 5, 5, Vec3::Zero(), -down, Vec3::UnitZ());
+            ClothMaterial m;
+            m.lift.value = Param(0.0);
+            m.drag.value = Param(0.0);
+            m.stretch = Param(1e4);
+            WorldSettings ws;
+            ws.gravity = Vec3(0, -g, 0);
+            ws.substeps = 1;
+            World w(ws);
+            w.addBody(std::make_unique<Cloth>("patch", mesh, m));
+            w.addCollider(plane);
+            int rejected = 0;
+            for (int f = 1; f <= 24; ++f) {
+                const BodyFrameStats b = w.advanceFrame(f).bodies[0];
+                rejected += b.rejected;
+                if (std::getenv("GALE_PROBE_INCLINE"))
+                    std::printf("theta %g mu %g f %d c %ld add %d rel %d slides %d solves %d "
+                                "proj %d\n",
+                                thetaDeg, mu, f, b.contactConstraints, b.contactAdded,
+                                b.contactReleases, b.contactSlides, b.contactSolves, b.projected);
+            }
+            const VecX& x = w.bodies()[0]->positions();
+            const VecX& v = w.bodies()[0]->velocities();
+            Vec3 c = Vec3::Zero(), c0 = Vec3::Zero(), vc = Vec3::Zero();
+            for (size_t i = 0; i < mesh.vertexCount(); ++i) {
+                c += vec3At(x.data(), i) / double(mesh.vertexCount());
+                c0 += mesh.position(i) / double(mesh.vertexCount());
+                vc += vec3At(v.data(), i) / double(mesh.vertexCount());
+            }
+            // The acceleration from the speed at T (backward Euler under a constant force gives
+            // v = a T exactly; its distance is ½ a T² (1 + h/T)).
+            const double accel = vc.dot(down) / T;
+            const double slid = (c - c0).dot(down);
+            const double a = g * (std::sin(theta) - mu * std::cos(theta));
+            INFO("theta " << thetaDeg << " mu " << mu << " acceleration " << accel
+                          << " m/s², closed form " << std::max(a, 0.0) << "; slid " << slid);
+            CHECK(rejected == 0);
+            if (a > 0) {
+                CHECK(accel == Approx(a).epsilon(0.02));
+            } else {
+                CHECK(std::abs(slid) < 1e-6);
+                CHECK(std::abs(accel) < 1e-6);
+            }
+            CHECK(std::abs((c - c0).dot(normal)) < 1e-6);
+        }
+    }
+}
