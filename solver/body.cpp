@@ -564,7 +564,15 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         }
         if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
             mDv = dvBase;
-            energy = elasticAt(x0 + h * v0, t1, mFel);
+            // ... or, when x₀ + h v₀ itself over-stretches (a fast incoming velocity), from
+            // the free directions at rest (x₁ = x₀, feasible by the detector's rule) and the
+            // constrained ones as prescribed: every later iterate must stay feasible too.
+            if (!stretchFeasible(x0 + h * v0)) {
+                VecX d = -v0 - dvLin;
+                mConstraints.apply(d.data());
+                mDv = dvLin + d;
+            }
+            energy = elasticAt(x0 + h * (v0 + mDv), t1, mFel);
             break;
         }
         alpha *= 0.5;
@@ -769,6 +777,8 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         else
             mDv.setZero(3 * n);
         mSolver.setPreconditioner(mOptions.preconditioner);
+        // The multigrid's near-null space: rigid-body modes about the substep's start positions.
+        mSolver.multigrid().setPositions(x0.data(), static_cast<int>(n));
         ls = solveLinear(mB, mDv);
     }
     st.iterations = ls.iterations;

@@ -134,152 +134,216 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     mPatternSlots = A.slotCount();
 }
 
-// Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
-// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit),
-// rows visited in their natural order (fine.visit); builds the pattern of `coarse` — its rows
-// (the aggregates, numbered in the order they were found) coloured and renumbered in colour
-// order — and the slot maps.
-void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
-    const BsrMatrix& a = fine.a;
-    const int n = a.n;
-    std::vector<int> agg(n, -1), size;
-    // 1. Roots: a vertex whose neighbours are all unaggregated starts an aggregate with them.
-    for (int s = 0; s < n; ++s) {
-        const int i = fine.visit[s];
-        if (agg[i] >= 0) continue;
-        bool free = true;
-        for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
-            if (agg[a.cols[k]] >= 0) free = false;
-        if (!free) continue;
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) agg[a.cols[k]] = static_cast<int>(size.size());
-        size.push_back(a.start[i + 1] - a.start[i]);
+// The pattern of level l + 1 from level l's: nodes (agg.d rows each) aggregated on the node
+// graph in natural order (fine.visit), P's pattern and the Galerkin pattern in the aggregates'
+// natural numbering, which is then coloured; everything is renumbered in the coarse colour
+// order. Block boundaries of the colouring are multiples of the rows per node, so a coarse
+// node's rows stay consecutive there.
+bool BlockMultigrid::buildCoarse(int l) {
+    Level& f = mLevels[l];
+    const BsrMatrix& a = f.a;
+    const int d = f.agg.d, dc = mModes / 3;
+    const int nodes = a.n / d;
+    std::vector<int> row, nodeVisit(nodes);
+    if (l == 0) { // level 0's node graph: A's pattern
+        f.graphStart.assign(a.start.begin(), a.start.end());
+        f.graphCols.assign(a.cols.begin(), a.cols.end());
     }
-    // 2. The rest join the smallest neighbouring aggregate (ties: the lower index), decided
-    // from the phase-1 labels only, so the order of the rows does not matter.
-    std::vector<int> joined = agg;
-    for (int i = 0; i < n; ++i) {
-        if (agg[i] >= 0) continue;
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-            const int J = agg[a.cols[k]];
-            if (J >= 0 && (joined[i] < 0 || size[J] < size[joined[i]] || (size[J] == size[joined[i]] && J < joined[i])))
-                joined[i] = J;
-        }
+    const std::vector<int>& nStart = f.graphStart;
+    const std::vector<int>& nCols = f.graphCols;
+    for (int s = 0; s < nodes; ++s) nodeVisit[s] = f.visit[s * d] / d;
+    std::vector<int> joined;
+    const int count = aggregateNodes(nodes, nStart.data(), nCols.data(), nodeVisit, joined);
+    if (5 * static_cast<long>(count) * dc > 4 * static_cast<long>(a.n)) return false; // stalls
+    Aggregates& g = f.agg;
+    g.nodeAgg = joined;
+    g.memberStart.assign(count + 1, 0); // (natural numbering: only the count matters here)
+    BlockProlongator& P = f.P;
+    prolongatorPattern(a, g, dc, mSettings.smoothed, P);
+    P.buildTranspose();
+    std::vector<int> natStart, natCols;
+    galerkinPattern(a, P, natStart, natCols);
+    const int nc = dc * count;
+    Level c;
+    const int block = (std::max(mSettings.rowBlock, 1) + dc - 1) / dc * dc;
+    c.colouring = colourRows(mSettings.multicolour, block, nc, natStart.data(), natCols.data());
+    const std::vector<int>& order = c.colouring.order;
+    c.visit.resize(nc);
+    for (int p = 0; p < nc; ++p) c.visit[order[p]] = p;
+    c.agg.d = dc;
+    // Renumber: nodes, P's columns (rows re-sorted), members, the coarse pattern.
+    for (int u = 0; u < nodes; ++u) g.nodeAgg[u] = c.visit[joined[u] * dc] / dc;
+    for (int r = 0; r < a.n; ++r) {
+        for (int k = P.start[r]; k < P.start[r + 1]; ++k) P.cols[k] = c.visit[P.cols[k]];
+        std::sort(P.cols.begin() + P.start[r], P.cols.begin() + P.start[r + 1]);
     }
-    // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
-    int count = static_cast<int>(size.size());
-    for (int s = 0; s < n; ++s) {
-        const int i = fine.visit[s];
-        if (joined[i] >= 0) continue;
-        joined[i] = count;
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
-            if (joined[a.cols[k]] < 0) joined[a.cols[k]] = count;
-        ++count;
-    }
-    // The coarse graph in the aggregates' natural numbering, coloured in that order; coarse
-    // row P is aggregate order[P].
-    std::vector<std::vector<int>> rows(count);
-    for (int i = 0; i < n; ++i)
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
-            rows[joined[i]].push_back(joined[a.cols[k]]);
-    std::vector<int> natStart(count + 1, 0), natCols;
-    for (int I = 0; I < count; ++I) {
-        std::sort(rows[I].begin(), rows[I].end());
-        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
-        natCols.insert(natCols.end(), rows[I].begin(), rows[I].end());
-        natStart[I + 1] = static_cast<int>(natCols.size());
-    }
-    coarse.colouring = colourRows(mSettings.multicolour, mSettings.rowBlock, count, natStart.data(),
-                                  natCols.data());
-    const std::vector<int>& order = coarse.colouring.order;
-    coarse.visit.resize(count);
-    for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
-    fine.agg.resize(n);
-    for (int i = 0; i < n; ++i) fine.agg[i] = coarse.visit[joined[i]];
-    fine.memberStart.assign(count + 1, 0);
-    for (int i = 0; i < n; ++i) ++fine.memberStart[fine.agg[i] + 1];
-    for (int I = 0; I < count; ++I) fine.memberStart[I + 1] += fine.memberStart[I];
-    fine.members.resize(n);
+    P.buildTranspose();
+    g.memberStart.assign(count + 1, 0);
+    for (int u = 0; u < nodes; ++u) ++g.memberStart[g.nodeAgg[u] + 1];
+    for (int J = 0; J < count; ++J) g.memberStart[J + 1] += g.memberStart[J];
+    g.members.resize(nodes);
     {
-        std::vector<int> fill(fine.memberStart.begin(), fine.memberStart.end() - 1);
-        for (int i = 0; i < n; ++i) fine.members[fill[fine.agg[i]]++] = i;
+        std::vector<int> fill(g.memberStart.begin(), g.memberStart.end() - 1);
+        for (int u = 0; u < nodes; ++u) g.members[fill[g.nodeAgg[u]]++] = u;
     }
-    // Coarse pattern: (agg i, agg j) for every fine block (i, j), in the coarse numbering.
-    BsrMatrix& c = coarse.a;
-    c.n = count;
-    c.start.assign(count + 1, 0);
-    c.cols.clear();
-    std::vector<int> row;
-    for (int P = 0; P < count; ++P) {
+    BsrMatrix& cm = c.a;
+    cm.n = nc;
+    cm.start.assign(nc + 1, 0);
+    cm.cols.clear();
+    for (int p = 0; p < nc; ++p) {
         row.clear();
-        for (int k = natStart[order[P]]; k < natStart[order[P] + 1]; ++k)
-            row.push_back(coarse.visit[natCols[k]]);
+        for (int k = natStart[order[p]]; k < natStart[order[p] + 1]; ++k) row.push_back(c.visit[natCols[k]]);
         std::sort(row.begin(), row.end());
-        c.cols.insert(c.cols.end(), row.begin(), row.end());
-        c.start[P + 1] = static_cast<int>(c.cols.size());
+        cm.cols.insert(cm.cols.end(), row.begin(), row.end());
+        cm.start[p + 1] = static_cast<int>(cm.cols.size());
     }
-    finishPattern(c);
-    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
-    fine.coarseSlot.resize(a.cols.size());
-    for (int i = 0; i < n; ++i)
-        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
-            fine.coarseSlot[k] = slotIn(c, fine.agg[i], fine.agg[a.cols[k]]);
-    // The same map inverted, for the coarsening's gather: the fine slots of each coarse slot in
-    // increasing order.
-    fine.gatherStart.assign(c.cols.size() + 1, 0);
-    for (int K : fine.coarseSlot) ++fine.gatherStart[K + 1];
-    for (size_t K = 0; K < c.cols.size(); ++K) fine.gatherStart[K + 1] += fine.gatherStart[K];
-    fine.gather.resize(a.cols.size());
-    std::vector<int> fill(fine.gatherStart.begin(), fine.gatherStart.end() - 1);
-    for (int k = 0; k < a.blocks(); ++k) fine.gather[fill[fine.coarseSlot[k]]++] = k;
+    finishPattern(cm);
+    cm.val.assign(9 * cm.cols.size() + kBsrPad, 0.0);
+    // The coarse node graph the next aggregation reads: aggregates neighbour when two of their
+    // nodes do (the tentative prolongator's pattern, not the smoothed one's wider stencil: that
+    // would grow the aggregates about threefold per level and coarsen too fast).
+    c.graphStart.assign(count + 1, 0);
+    c.graphCols.clear();
+    for (int J = 0; J < count; ++J) {
+        row.clear();
+        for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+            const int u = g.members[t];
+            for (int k = nStart[u]; k < nStart[u + 1]; ++k) row.push_back(g.nodeAgg[nCols[k]]);
+        }
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        c.graphCols.insert(c.graphCols.end(), row.begin(), row.end());
+        c.graphStart[J + 1] = static_cast<int>(c.graphCols.size());
+    }
+    mLevels.push_back(std::move(c));
+    return true;
 }
 
-// A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
-// I − S part and aggregates with a direction no member can move in get an identity there.
-void BlockMultigrid::coarsen(int l) {
-    Level& f = mLevels[l];
-    BsrMatrix& c = mLevels[l + 1].a;
-    const BsrMatrix& a = f.a;
-    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
-    parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
-        for (int K = c.start[I0]; K < c.start[I1]; ++K) {
-            double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-            for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
-                const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
-                for (int q = 0; q < 9; ++q) sum[q] += src[q];
+// Level 0's near-null space from the positions and filters (multigrid.h): per aggregate its
+// centroid and radius, per row S_i [I | −[x_i − c]× / ρ].
+void BlockMultigrid::levelZeroNullSpace() {
+    Level& L = mLevels[0];
+    const Aggregates& g = L.agg;
+    const int m = mModes;
+    const size_t stride = 3 * static_cast<size_t>(m);
+    L.nullB.assign(stride * L.a.n, 0.0);
+    const int count = static_cast<int>(g.memberStart.size()) - 1;
+    parallelChunks(static_cast<size_t>(count), 64, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J) {
+            Vec3 c = Vec3::Zero();
+            double radius = 0.0;
+            if (m == 6) {
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    c += vec3At(mPositions.data(), mOrder[g.members[t]]);
+                c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    radius = std::max(radius, (vec3At(mPositions.data(), mOrder[g.members[t]]) - c).norm());
             }
-            std::copy(sum, sum + 9, c.val.data() + 9 * static_cast<size_t>(K));
+            const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
+            for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+                const int i = g.members[t];
+                const Mat3 S = mKind.empty() ? Mat3::Identity()
+                                             : Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+                double* B = L.nullB.data() + stride * i;
+                BlockMap translations(B);
+                translations = S;
+                if (m == 6) {
+                    const Vec3 p = inv * (vec3At(mPositions.data(), mOrder[i]) - c);
+                    Mat3 cross;
+                    cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
+                    BlockMap(B + 9) = -S * cross;
+                }
+            }
         }
     });
-    if (l != 0 || mKind.empty()) return;
-    for (int i = 0; i < a.n; ++i) {
-        if (!mKind[i]) continue;
-        // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
-        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.agg[i]])) -=
-            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+}
+
+// A_{l+1} = P_lᵀ A_l P_l with P_l the smoothed tentative prolongator of B_l (multigrid.h);
+// coarse unknowns no mode reaches get a unit diagonal (their rows and columns are zero).
+void BlockMultigrid::coarsenValues(int l) {
+    Level& f = mLevels[l];
+    Level& c = mLevels[l + 1];
+    if (l == 0) levelZeroNullSpace();
+    double omega = 0.0;
+    if (mSettings.smoothed) {
+        const double rho = spectralRadiusDinvA(f.a, f.dinv.data(), mSettings.powerIterations);
+        omega = mSettings.prolongatorDamping / rho;
     }
-    for (int I = 0; I < c.n; ++I) {
-        bool any = false;
-        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) any = any || mKind[f.members[m]];
-        if (!any) continue;
-        Mat3 B = Mat3::Zero();
-        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) {
-            const int i = f.members[m];
-            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
-        }
-        Eigen::SelfAdjointEigenSolver<Mat3> es(B);
-        BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
-        const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
-        for (int e = 0; e < 3; ++e)
-            if (es.eigenvalues()[e] < 1e-8) {
-                const Vec3 v = es.eigenvectors().col(e);
-                d += scale * v * v.transpose();
+    tentativeProlongator(f.agg, mModes, f.nullB, f.Q, c.nullB, c.dead);
+    smoothProlongator(f.a, f.agg, mModes / 3, omega, f.Q, f.P);
+    galerkinValues(f.a, f.P, c.a);
+    for (int J = 0; J < c.a.n; ++J) {
+        const uint8_t* dead = c.dead.data() + 3 * static_cast<size_t>(J);
+        if (!(dead[0] | dead[1] | dead[2])) continue;
+        BlockMap D(c.a.val.data() + 9 * static_cast<size_t>(c.a.diag[J]));
+        double live = 0.0;
+        int nLive = 0;
+        for (int q = 0; q < 3; ++q)
+            if (!dead[q]) {
+                live += D(q, q);
+                ++nLive;
             }
+        const double scale = nLive > 0 && live > 0.0 ? live / nLive : 1.0;
+        for (int q = 0; q < 3; ++q)
+            if (dead[q]) D(q, q) = scale;
     }
+}
+
+// A level's single-precision copy (level 0's is made by refresh), diagonal inverses and work
+// vectors.
+void BlockMultigrid::finishLevel(int l) {
+    Level& L = mLevels[l];
+    if (l != 0) {
+        L.lowVal.resize(L.a.val.size());
+        parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        });
+    }
+    L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
+    std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
+    // The inverse of the single-precision diagonal, so that every sweep reads one matrix
+    // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+            BlockMap(L.dinv.data() + 9 * i) =
+                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
+        }
+    });
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    L.r.resize(n3);
+    L.x.resize(n3);
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    L.t.resize(n3);
+}
+
+size_t BlockMultigrid::bytes() const {
+    size_t b = 0;
+    auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
+    for (const Level& L : mLevels) {
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.mirror), v(L.a.val), v(L.lowVal), v(L.dinv);
+        v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
+        v(L.nullB), v(L.dead), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
+        v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot), v(L.Q);
+        v(L.r), v(L.x), v(L.t);
+    }
+    v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
+    b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double);
+    return b;
 }
 
 bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained) {
-    const bool fresh = mLevels.empty() || mPatternRows != A.size() || mPatternSlots != A.slotCount();
-    if (fresh) buildHierarchy(A);
+    const int modes = mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
+    const bool fresh = mLevels.empty() || mPatternRows != A.size() ||
+                       mPatternSlots != A.slotCount() || modes != mModes;
+    mModes = modes;
+    if (fresh) {
+        buildHierarchy(A);
+        while (mLevels.back().a.n > mSettings.coarsest &&
+               buildCoarse(static_cast<int>(mLevels.size()) - 1)) {
+        }
+    }
     // Level 0: Â = S A S + I − S.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
@@ -341,46 +405,11 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             lower(a.diag[i]);
         }
     }
-    // Coarse levels: aggregate on first sight of the pattern, then sum.
-    for (int l = 0;; ++l) {
-        if (fresh) {
-            if (mLevels[l].a.n <= mSettings.coarsest) break;
-            Level next;
-            aggregate(mLevels[l], next);
-            if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
-                mLevels[l].agg.clear();
-                break;
-            }
-            mLevels.push_back(std::move(next));
-        } else if (l + 1 >= static_cast<int>(mLevels.size())) {
-            break;
-        }
-        coarsen(l);
-    }
-    for (Level& L : mLevels) {
-        if (&L != &mLevels[0]) { // level 0's copy was made above
-            L.lowVal.resize(L.a.val.size());
-            parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
-                for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
-            });
-        }
-        L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
-        std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
-        // The inverse of the single-precision diagonal, so that every sweep reads one matrix
-        // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
-        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-            for (size_t i = i0; i < i1; ++i) {
-                const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
-                BlockMap(L.dinv.data() + 9 * i) =
-                    invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
-            }
-        });
-        const size_t n3 = 3 * static_cast<size_t>(L.a.n);
-        L.r.resize(n3);
-        L.x.resize(n3);
-        L.rp = L.r.data();
-        L.xp = L.x.data();
-        L.t.resize(n3);
+    // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
+    // one's values from it.
+    for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
+        finishLevel(l);
+        if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
     }
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
     // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
@@ -473,35 +502,18 @@ void BlockMultigrid::cycle(int l) {
         a.multiply(L.xp, L.t.data());
         for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
     }
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
     Level& C = mLevels[l + 1];
-    const BsrPattern p = a.pattern();
-    const bool filtered = l == 0 && !mKind.empty();
-    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
-        for (size_t I = I0; I < I1; ++I) {
-            Vec3 s = Vec3::Zero();
-            for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
-                const int i = L.members[m];
-                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
-                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i])
-                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
-                s += t;
-            }
-            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
-        }
-    });
+    if (pull) {
+        const BsrPattern p = a.pattern();
+        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+            bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i0, i1);
+        });
+    }
+    L.P.restrictTo(L.t.data(), C.r.data());
     cycle(l + 1);
-    // x += α S P_tent e.
-    const double alpha = mSettings.coarseWeight;
-    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) {
-            const int I = L.agg[i];
-            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
-            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
-            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
-        }
-    });
+    // x += α P e.
+    L.P.prolongAdd(C.x.data(), mSettings.coarseWeight, L.xp);
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
 }
 

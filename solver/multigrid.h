@@ -4,6 +4,7 @@
 #pragma once
 
 #include "solver/bsr_kernels.h"
+#include "solver/prolongator.h"
 #include "solver/types.h"
 
 #include <Eigen/Cholesky>
@@ -37,14 +38,25 @@ struct BsrMatrix {
     double multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single = nullptr) const;
 };
 
-// Plain (unsmoothed) aggregation AMG with a constraint-filtered tentative prolongator:
-//   P₀ = S P_tent,  P_tent(i, I) = I₃ when vertex i is in aggregate I  (translations: the
-// near-null space of the membrane stiffness), so the Galerkin operators
-//   A_{l+1} = P_lᵀ A_l P_l
-// are sums of the fine blocks and the coarse levels never see the constrained directions
-// (Tamstorf et al. 2015, §4). Aggregates (Vaněk, Mandel, Brezina 1996: a root plus its
-// neighbours, then the rest joined to a neighbouring aggregate) are chosen once per matrix
-// pattern, from the pattern alone; every later refresh only re-sums the values.
+// Smoothed-aggregation AMG (Vaněk, Mandel, Brezina 1996) for the filtered system
+//   Â = S A S + I − S                                        (Tamstorf, Jones, McCormick 2015)
+// with a near-null space B of rigid-body modes filtered by the constraints: for vertex i at x_i
+// in an aggregate with centroid c,
+//   B_i = S_i [ I₃ | −[x_i − c]× / ρ ]   (translations and rotations; ρ the aggregate's radius),
+// or the translations S_i alone when no positions are given (setPositions). Per level:
+//   P_tent = blockdiag(Q_J),  B_J = Q_J R_J  (orthonormalised on each aggregate J),
+//   P = (I − ω D⁻¹ Â) P_tent,  ω = (4/3) / ρ(D⁻¹Â)  (ρ by a few power steps),
+//   A_{l+1} = Pᵀ A_l P,   B_{l+1} = R,
+// so every level holds 6 unknowns per aggregate (two 3×3 block rows; one with translations
+// only). Rows of P lie in range(S_i) by construction (D_i⁻¹ keeps range(S_i)), so the coarse
+// levels never see the constrained directions, whatever the per-vertex filter (I, I − nnᵀ, 0).
+// Coarse unknowns no mode reaches (a fully pinned aggregate, a straight strand's twist) get an
+// identity diagonal and stay zero. Aggregates (a root plus its neighbours, then the rest joined
+// to a neighbouring aggregate) are chosen once per matrix pattern, from the pattern alone, on
+// the graph of nodes (a coarse node's two block rows aggregate together); every later refresh
+// recomputes the values (B, P, ω and the Galerkin products) from the current matrix and
+// positions only, so a resumed run builds the same hierarchy bit for bit. With `smoothed` off
+// and `rotations` off this is plain aggregation with translations (the benchmark's baseline).
 // The V-cycle uses damped block-Jacobi smoothing (ν sweeps before and the same after) or a
 // forward/backward multicolour block Gauss–Seidel pair, and a dense Cholesky on the coarsest
 // level, so the preconditioner is symmetric positive definite.
@@ -78,6 +90,10 @@ public:
         int rowBlock = 128;         // rows per block of the multicolour ordering
         bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
                                     // always sequential (the benchmark's baseline)
+        bool smoothed = true;       // P = (I − ω D⁻¹ Â) P_tent; false: P = P_tent (plain)
+        bool rotations = true;      // rotations in the near-null space (when positions are set)
+        double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
+        int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
     };
 
     // The settings new instances start with (process-wide, like setWideKernels: change them
@@ -85,6 +101,10 @@ public:
     static Settings& defaults();
 
     Settings& settings() { return mSettings; }
+
+    // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
+    // space; copied. Without them (or with another count) the near-null space is translations.
+    void setPositions(const double* x, int n) { mPositions.assign(x, x + 3 * static_cast<size_t>(n)); }
 
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
     // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
@@ -110,27 +130,34 @@ public:
 
     int levelCount() const { return static_cast<int>(mLevels.size()); }
     int rows(int level) const { return mLevels[level].a.n; }
+    // Near-null modes per node of the coarse levels (6 with rotations, else 3).
+    int modes() const { return mModes; }
+    // Bytes held by the hierarchy (matrices, prolongators, work vectors).
+    size_t bytes() const;
 
 private:
     struct Level {
         BsrMatrix a;
         std::vector<float> lowVal;     // a.val in single precision, read by the smoother
         std::vector<double> dinv;      // 9 per row: inverse diagonal block
-        std::vector<int> agg;          // aggregate (row of the next level) per row
-        std::vector<int> memberStart, members; // rows of each aggregate
-        std::vector<int> coarseSlot;   // slot of the next level's matrix per slot
-        std::vector<int> gatherStart,
-            gather;                    // per slot of the next level: the slots summed into it
         ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
         std::vector<int> visit;        // row of each natural index (the aggregation's order)
+        std::vector<double> nullB;     // near-null space: 3×modes per row, column-major
+        std::vector<uint8_t> dead;     // per scalar unknown: no mode reaches it (coarse levels)
+        std::vector<int> graphStart, graphCols; // node graph (colour-order nodes) to aggregate
+        Aggregates agg;                // nodes of this level → nodes of the next (agg.d: rows per node)
+        BlockProlongator P;            // to the next level
+        std::vector<double> Q;         // tentative prolongator: 3×modes per row
         std::vector<double> r, x, t;   // 3n work vectors
         const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
         double* xp = nullptr;
     };
 
     void buildHierarchy(const BlockMatrix& A);
-    void aggregate(Level& fine, Level& coarse);
-    void coarsen(int l);
+    bool buildCoarse(int l); // false: coarsening stalls
+    void levelZeroNullSpace();
+    void coarsenValues(int l);
+    void finishLevel(int l);
     // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
     // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
@@ -144,6 +171,8 @@ private:
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;
+    std::vector<double> mPositions; // A's order, for the rotations
+    int mModes = 3;
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
     Eigen::MatrixXd mCoarseDense;
     bool mCoarseOk = false;
