@@ -389,8 +389,10 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
         int k = 0;
         for (int j = 0; j < kGmresRestart; ++j) {
             Z[j].setZero(n3);
+            mSolver.setKeepCoarse(true); // the same matrix as the solve above
             const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver,
                                                  precTolerance, mOptions.cgMaxIterations);
+            mSolver.setKeepCoarse(false);
             ls.iterations += ps.iterations;
             if (ps.failed || !Z[j].allFinite()) {
                 failed = true;
@@ -592,7 +594,10 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         mGk = mF - mFel;
         rhs = -mG;
         delta.setZero();
+        // (Options::newtonKeepCoarse: the linearised step's coarse levels, level 0 refreshed.)
+        mSolver.setKeepCoarse(mOptions.newtonKeepCoarse);
         const SolveStatus ns = solveLinear(rhs, delta);
+        mSolver.setKeepCoarse(false);
         st.iterations += ns.iterations;
         st.residual = std::max(st.residual, ns.residual);
         ++st.newtonIterations;

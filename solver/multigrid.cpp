@@ -333,11 +333,14 @@ size_t BlockMultigrid::bytes() const {
     return b;
 }
 
-bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained) {
+bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained,
+                             bool keepCoarse) {
     const int modes = mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
     const bool fresh = mLevels.empty() || mPatternRows != A.size() ||
                        mPatternSlots != A.slotCount() || modes != mModes;
     mModes = modes;
+    std::vector<uint8_t> kindsBefore;
+    if (keepCoarse && !fresh) kindsBefore = mKind;
     if (fresh) {
         buildHierarchy(A);
         while (mLevels.back().a.n > mSettings.coarsest &&
@@ -407,10 +410,13 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     }
     // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
     // one's values from it.
+    const bool reuse = keepCoarse && !fresh && kindsBefore == mKind && mHaveCoarse;
     for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
         finishLevel(l);
+        if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
         if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
     }
+    mHaveCoarse = true;
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
     // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
     const BsrMatrix& c = mLevels.back().a;

@@ -109,7 +109,12 @@ public:
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
     // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
     // when a value is not finite.
-    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained);
+    // keepCoarse: only level 0 takes A's values; the coarse levels and prolongators stay those
+    // of the last full refresh (still an SPD preconditioner, for a matrix that changed little:
+    // Newton's iterates, GMRES's repeated solves with one matrix). Ignored when the pattern
+    // or the constrained rows changed.
+    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained,
+                 bool keepCoarse = false);
     // 3n vectors from A's vertex order to level 0's colour order and back.
     void toLevelOrder(const double* natural, double* level) const;
     void fromLevelOrder(const double* level, double* natural) const;
@@ -173,6 +178,7 @@ private:
     std::vector<double> mNormal;
     std::vector<double> mPositions; // A's order, for the rotations
     int mModes = 3;
+    bool mHaveCoarse = false; // the coarse levels hold values (keepCoarse may reuse them)
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
     Eigen::MatrixXd mCoarseDense;
     bool mCoarseOk = false;
