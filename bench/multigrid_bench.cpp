@@ -4,10 +4,10 @@
 // aggregation with rotations against the plain aggregation baseline measured in the same run
 // (and hypre's BoomerAMG on the same matrices when built with it); speed against error.
 //   gale_bench_multigrid [--quick] [--only scaling|error] [--size N]
-#include "solver/linear.h"
-#include "solver/multigrid.h"
-#include "solver/test_sheets.h"
-#include "solver/types.h"
+#include "solver/linalg/linear.h"
+#include "solver/linalg/multigrid.h"
+#include "solver/linalg/test_sheets.h"
+#include "solver/linalg/types.h"
 
 #include <tbb/task_arena.h>
 

@@ -1,0 +1,553 @@
+// Aggregation AMG preconditioner for the filtered cloth system and its BSR matrix (see
+// multigrid.h). References: Vaněk, Mandel, Brezina, "Algebraic multigrid by smoothed
+// aggregation", Computing 56 (1996); Tamstorf, Jones, McCormick, "Smoothed aggregation
+// multigrid for cloth simulation", SIGGRAPH Asia 2015.
+#include "solver/linalg/multigrid.h"
+
+#include "solver/linalg/bsr_kernels.h"
+#include "solver/linalg/linear.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+namespace gale::solver {
+
+namespace {
+
+// Blocks are stored column-major, 9 values each (bsr_kernels.h).
+using BlockMap = Eigen::Map<Mat3>;
+using ConstBlockMap = Eigen::Map<const Mat3>;
+
+// The multicolour ordering of a level (types.h, ColouredBlocks): its rows, in natural order, cut
+// into blocks of `rowBlock`; two blocks neighbour when a row of one shares a matrix block
+// with a row of the other. Without `multicolour`: the natural order, one block.
+ColouredBlocks colourRows(bool multicolour, int rowBlock, int n, const int* start,
+                          const int* cols) {
+    if (!multicolour || rowBlock <= 0 || n <= rowBlock) return naturalBlocks(n);
+    std::vector<std::vector<int>> near((n + rowBlock - 1) / rowBlock);
+    for (int i = 0; i < n; ++i) {
+        std::vector<int>& nb = near[i / rowBlock];
+        for (int k = start[i]; k < start[i + 1]; ++k)
+            if (cols[k] / rowBlock != i / rowBlock) nb.push_back(cols[k] / rowBlock);
+    }
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    return colourBlocks(n, rowBlock, near);
+}
+
+int slotIn(const BsrMatrix& m, int i, int j) {
+    auto b = m.cols.begin() + m.start[i], e = m.cols.begin() + m.start[i + 1];
+    return static_cast<int>(std::lower_bound(b, e, j) - m.cols.begin());
+}
+
+// diag and mirror of a pattern with sorted columns, symmetric, the diagonal present.
+void finishPattern(BsrMatrix& m) {
+    m.diag.resize(m.n);
+    m.mirror.resize(m.cols.size());
+    for (int i = 0; i < m.n; ++i) {
+        m.diag[i] = slotIn(m, i, i);
+        for (int k = m.start[i]; k < m.start[i + 1]; ++k) m.mirror[k] = slotIn(m, m.cols[k], i);
+    }
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BsrMatrix
+
+void BsrMatrix::multiply(const double* x, double* y) const {
+    const BsrPattern p = pattern();
+    parallelChunks(static_cast<size_t>(n), 512,
+                   [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
+}
+
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single) const {
+    const size_t n3 = 3 * static_cast<size_t>(n);
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    const size_t rowsPerChunk = kReduceChunk / 3;
+    const BsrPattern p = pattern();
+    partial.assign(chunks, 0.0);
+    parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+        for (size_t ch = c0; ch < c1; ++ch) {
+            const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
+            const size_t i0 = ch * rowsPerChunk;
+            if (single) bsrMultiplyRows(p, single, x, y, i0, i1);
+            else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
+            double s = 0.0;
+            for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
+            partial[ch] = s;
+        }
+    });
+    double s = 0.0;
+    for (double p : partial) s += p;
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: set-up
+
+BlockMultigrid::Settings& BlockMultigrid::defaults() {
+    static Settings settings;
+    return settings;
+}
+
+// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
+// slot k holds A's slot mSrcSlot[k]).
+void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
+    mLevels.assign(1, Level());
+    Level& L = mLevels[0];
+    BsrMatrix& a = L.a;
+    const int n = A.size();
+    const std::vector<int>& start = A.blockRowStart();
+    const std::vector<int>& cols = A.blockCols();
+    L.colouring =
+        colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
+    mOrder = L.colouring.order;
+    L.visit.resize(n);
+    for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
+    a.n = n;
+    a.start.assign(n + 1, 0);
+    a.cols.clear();
+    mSrcSlot.clear();
+    std::vector<std::pair<int, int>> row; // (level-0 column, A's slot)
+    for (int p = 0; p < n; ++p) {
+        const int i = mOrder[p];
+        row.clear();
+        for (int k = start[i]; k < start[i + 1]; ++k) row.push_back({L.visit[cols[k]], k});
+        std::sort(row.begin(), row.end());
+        for (const auto& e : row) {
+            a.cols.push_back(e.first);
+            mSrcSlot.push_back(e.second);
+        }
+        a.start[p + 1] = static_cast<int>(a.cols.size());
+    }
+    finishPattern(a);
+    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
+    mPatternRows = A.size();
+    mPatternSlots = A.slotCount();
+}
+
+// The pattern of level l + 1 from level l's: nodes (agg.d rows each) aggregated on the node
+// graph in natural order (fine.visit), P's pattern and the Galerkin pattern in the aggregates'
+// natural numbering, which is then coloured; everything is renumbered in the coarse colour
+// order. Block boundaries of the colouring are multiples of the rows per node, so a coarse
+// node's rows stay consecutive there.
+bool BlockMultigrid::buildCoarse(int l) {
+    Level& f = mLevels[l];
+    const BsrMatrix& a = f.a;
+    const int d = f.agg.d, dc = mModes / 3;
+    const int nodes = a.n / d;
+    std::vector<int> row, nodeVisit(nodes);
+    if (l == 0) { // level 0's node graph: A's pattern
+        f.graphStart.assign(a.start.begin(), a.start.end());
+        f.graphCols.assign(a.cols.begin(), a.cols.end());
+    }
+    const std::vector<int>& nStart = f.graphStart;
+    const std::vector<int>& nCols = f.graphCols;
+    for (int s = 0; s < nodes; ++s) nodeVisit[s] = f.visit[s * d] / d;
+    std::vector<int> joined;
+    const int count = aggregateNodes(nodes, nStart.data(), nCols.data(), nodeVisit, joined);
+    if (5 * static_cast<long>(count) * dc > 4 * static_cast<long>(a.n)) return false; // stalls
+    Aggregates& g = f.agg;
+    g.nodeAgg = joined;
+    g.memberStart.assign(count + 1, 0); // (natural numbering: only the count matters here)
+    BlockProlongator& P = f.P;
+    prolongatorPattern(a, g, dc, mSettings.smoothed, P);
+    P.buildTranspose();
+    std::vector<int> natStart, natCols;
+    galerkinPattern(a, P, natStart, natCols);
+    const int nc = dc * count;
+    Level c;
+    const int block = (std::max(mSettings.rowBlock, 1) + dc - 1) / dc * dc;
+    c.colouring = colourRows(mSettings.multicolour, block, nc, natStart.data(), natCols.data());
+    const std::vector<int>& order = c.colouring.order;
+    c.visit.resize(nc);
+    for (int p = 0; p < nc; ++p) c.visit[order[p]] = p;
+    c.agg.d = dc;
+    // Renumber: nodes, P's columns (rows re-sorted), members, the coarse pattern.
+    for (int u = 0; u < nodes; ++u) g.nodeAgg[u] = c.visit[joined[u] * dc] / dc;
+    for (int r = 0; r < a.n; ++r) {
+        for (int k = P.start[r]; k < P.start[r + 1]; ++k) P.cols[k] = c.visit[P.cols[k]];
+        std::sort(P.cols.begin() + P.start[r], P.cols.begin() + P.start[r + 1]);
+    }
+    P.buildTranspose();
+    g.memberStart.assign(count + 1, 0);
+    for (int u = 0; u < nodes; ++u) ++g.memberStart[g.nodeAgg[u] + 1];
+    for (int J = 0; J < count; ++J) g.memberStart[J + 1] += g.memberStart[J];
+    g.members.resize(nodes);
+    {
+        std::vector<int> fill(g.memberStart.begin(), g.memberStart.end() - 1);
+        for (int u = 0; u < nodes; ++u) g.members[fill[g.nodeAgg[u]]++] = u;
+    }
+    BsrMatrix& cm = c.a;
+    cm.n = nc;
+    cm.start.assign(nc + 1, 0);
+    cm.cols.clear();
+    for (int p = 0; p < nc; ++p) {
+        row.clear();
+        for (int k = natStart[order[p]]; k < natStart[order[p] + 1]; ++k) row.push_back(c.visit[natCols[k]]);
+        std::sort(row.begin(), row.end());
+        cm.cols.insert(cm.cols.end(), row.begin(), row.end());
+        cm.start[p + 1] = static_cast<int>(cm.cols.size());
+    }
+    finishPattern(cm);
+    cm.val.assign(9 * cm.cols.size() + kBsrPad, 0.0);
+    // The coarse node graph the next aggregation reads: aggregates neighbour when two of their
+    // nodes do (the tentative prolongator's pattern, not the smoothed one's wider stencil: that
+    // would grow the aggregates about threefold per level and coarsen too fast).
+    c.graphStart.assign(count + 1, 0);
+    c.graphCols.clear();
+    for (int J = 0; J < count; ++J) {
+        row.clear();
+        for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+            const int u = g.members[t];
+            for (int k = nStart[u]; k < nStart[u + 1]; ++k) row.push_back(g.nodeAgg[nCols[k]]);
+        }
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        c.graphCols.insert(c.graphCols.end(), row.begin(), row.end());
+        c.graphStart[J + 1] = static_cast<int>(c.graphCols.size());
+    }
+    mLevels.push_back(std::move(c));
+    return true;
+}
+
+// Level 0's near-null space from the positions and filters (multigrid.h): per aggregate its
+// centroid and radius, per row S_i [I | −[x_i − c]× / ρ].
+void BlockMultigrid::levelZeroNullSpace() {
+    Level& L = mLevels[0];
+    const Aggregates& g = L.agg;
+    const int m = mModes;
+    const size_t stride = 3 * static_cast<size_t>(m);
+    L.nullB.assign(stride * L.a.n, 0.0);
+    const int count = static_cast<int>(g.memberStart.size()) - 1;
+    parallelChunks(static_cast<size_t>(count), 64, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J) {
+            Vec3 c = Vec3::Zero();
+            double radius = 0.0;
+            if (m == 6) {
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    c += vec3At(mPositions.data(), mOrder[g.members[t]]);
+                c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    radius = std::max(radius, (vec3At(mPositions.data(), mOrder[g.members[t]]) - c).norm());
+            }
+            const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
+            for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+                const int i = g.members[t];
+                const Mat3 S = mKind.empty() ? Mat3::Identity()
+                                             : Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+                double* B = L.nullB.data() + stride * i;
+                BlockMap translations(B);
+                translations = S;
+                if (m == 6) {
+                    const Vec3 p = inv * (vec3At(mPositions.data(), mOrder[i]) - c);
+                    Mat3 cross;
+                    cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
+                    BlockMap(B + 9) = -S * cross;
+                }
+            }
+        }
+    });
+}
+
+// A_{l+1} = P_lᵀ A_l P_l with P_l the smoothed tentative prolongator of B_l (multigrid.h);
+// coarse unknowns no mode reaches get a unit diagonal (their rows and columns are zero).
+void BlockMultigrid::coarsenValues(int l) {
+    Level& f = mLevels[l];
+    Level& c = mLevels[l + 1];
+    if (l == 0) levelZeroNullSpace();
+    double omega = 0.0;
+    if (mSettings.smoothed) {
+        const double rho = spectralRadiusDinvA(f.a, f.dinv.data(), mSettings.powerIterations);
+        omega = mSettings.prolongatorDamping / rho;
+    }
+    tentativeProlongator(f.agg, mModes, f.nullB, f.Q, c.nullB, c.dead);
+    smoothProlongator(f.a, f.agg, mModes / 3, omega, f.Q, f.P);
+    galerkinValues(f.a, f.P, c.a);
+    for (int J = 0; J < c.a.n; ++J) {
+        const uint8_t* dead = c.dead.data() + 3 * static_cast<size_t>(J);
+        if (!(dead[0] | dead[1] | dead[2])) continue;
+        BlockMap D(c.a.val.data() + 9 * static_cast<size_t>(c.a.diag[J]));
+        double live = 0.0;
+        int nLive = 0;
+        for (int q = 0; q < 3; ++q)
+            if (!dead[q]) {
+                live += D(q, q);
+                ++nLive;
+            }
+        const double scale = nLive > 0 && live > 0.0 ? live / nLive : 1.0;
+        for (int q = 0; q < 3; ++q)
+            if (dead[q]) D(q, q) = scale;
+    }
+}
+
+// A level's single-precision copy (level 0's is made by refresh), diagonal inverses and work
+// vectors.
+void BlockMultigrid::finishLevel(int l) {
+    Level& L = mLevels[l];
+    if (l != 0) {
+        L.lowVal.resize(L.a.val.size());
+        parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        });
+    }
+    L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
+    std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
+    // The inverse of the single-precision diagonal, so that every sweep reads one matrix
+    // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+            BlockMap(L.dinv.data() + 9 * i) =
+                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
+        }
+    });
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    L.r.resize(n3);
+    L.x.resize(n3);
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    L.t.resize(n3);
+}
+
+size_t BlockMultigrid::bytes() const {
+    size_t b = 0;
+    auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
+    for (const Level& L : mLevels) {
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.mirror), v(L.a.val), v(L.lowVal), v(L.dinv);
+        v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
+        v(L.nullB), v(L.dead), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
+        v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot), v(L.Q);
+        v(L.r), v(L.x), v(L.t);
+    }
+    v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
+    b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double);
+    return b;
+}
+
+bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained,
+                             bool keepCoarse) {
+    const int modes = mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
+    const bool fresh = mLevels.empty() || mPatternRows != A.size() ||
+                       mPatternSlots != A.slotCount() || modes != mModes;
+    mModes = modes;
+    std::vector<uint8_t> kindsBefore;
+    if (keepCoarse && !fresh) kindsBefore = mKind;
+    if (fresh) {
+        buildHierarchy(A);
+        while (mLevels.back().a.n > mSettings.coarsest &&
+               buildCoarse(static_cast<int>(mLevels.size()) - 1)) {
+        }
+    }
+    // Level 0: Â = S A S + I − S.
+    BsrMatrix& a = mLevels[0].a;
+    const int n = a.n;
+    // One pass over A, rows in parallel: the double copy in level-0 order, its single-precision
+    // twin for the smoother and the CG products, and the finiteness check.
+    std::vector<float>& low = mLevels[0].lowVal;
+    low.resize(a.val.size());
+    std::fill(low.end() - kBsrPad, low.end(), 0.0f);
+    std::atomic<uint32_t> anyBad{0};
+    parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
+        const double* __restrict src = A.values();
+        double* __restrict dst = a.val.data();
+        float* __restrict lo = low.data();
+        const int k0 = a.start[i0], k1 = a.start[i1];
+        for (int k = k0; k < k1; ++k) {
+            const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
+            for (int q = 0; q < 9; ++q) {
+                dst[9 * static_cast<size_t>(k) + q] = s[q];
+                lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
+            }
+        }
+        // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or
+        // a value beyond float range, which the smoother could not use either); integer bit
+        // tests vectorise where isfinite on doubles does not.
+        uint32_t bad = 0;
+        for (size_t q = 9 * static_cast<size_t>(k0); q < 9 * static_cast<size_t>(k1); ++q) {
+            uint32_t bits;
+            std::memcpy(&bits, lo + q, sizeof bits);
+            bad |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+        }
+        if (bad) anyBad.fetch_or(1u, std::memory_order_relaxed);
+    });
+    if (anyBad.load()) return false;
+    auto lower = [&](int k) {
+        for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
+            low[q] = static_cast<float>(a.val[q]);
+    };
+    mKind.clear();
+    if (!constrained.empty()) {
+        mKind.assign(n, 0);
+        mNormal.assign(3 * static_cast<size_t>(n), 0.0);
+        for (int v : constrained) { // A's row v is level-0 row visit[v]
+            const int i = mLevels[0].visit[v];
+            mKind[i] = cons.kind[v];
+            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
+        }
+        for (int v : constrained) {
+            const int i = mLevels[0].visit[v];
+            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
+                row = (S * row).eval();
+                BlockMap col(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]));
+                col = (col * S).eval();
+                lower(k);
+                lower(a.mirror[k]);
+            }
+            BlockMap(a.val.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+            lower(a.diag[i]);
+        }
+    }
+    // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
+    // one's values from it.
+    const bool reuse = keepCoarse && !fresh && kindsBefore == mKind && mHaveCoarse;
+    for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
+        finishLevel(l);
+        if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
+        if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
+    }
+    mHaveCoarse = true;
+    // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
+    // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
+    const BsrMatrix& c = mLevels.back().a;
+    mCoarseOk = false;
+    if (c.n > 2 * std::max(mSettings.coarsest, 1)) return true;
+    mCoarseDense.setZero(3 * c.n, 3 * c.n);
+    for (int I = 0; I < c.n; ++I)
+        for (int k = c.start[I]; k < c.start[I + 1]; ++k)
+            mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) = ConstBlockMap(c.val.data() + 9 * static_cast<size_t>(k));
+    mCoarseLlt.compute(mCoarseDense);
+    mCoarseOk = mCoarseLlt.info() == Eigen::Success;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: the V-cycle
+
+bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
+    Level& L = mLevels[l];
+    const BsrMatrix& a = L.a;
+    const int n = a.n;
+    double* x = L.xp;
+    const double* r = L.rp;
+    if (mSettings.gaussSeidel) {
+        GaussSeidelSweep g;
+        g.pattern = a.pattern();
+        g.val = L.lowVal.data();
+        g.mirror = a.mirror.data();
+        g.dinv = L.dinv.data();
+        g.r = r;
+        g.x = x;
+        g.t = residual ? L.t.data() : nullptr;
+        g.forward = forward;
+        g.fromZero = fromZero && forward;
+        const bool parallel =
+            n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
+        // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
+        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
+        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
+        // the same sums in the same order.
+        if (parallel) g.t = nullptr;
+        forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
+            GaussSeidelSweep part = g;
+            part.begin = static_cast<int>(i0);
+            part.end = static_cast<int>(i1);
+            gaussSeidelSweep(part);
+        });
+        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
+    }
+    // Damped block Jacobi: x += ω D⁻¹ (r − A x).
+    const double w = mSettings.jacobiWeight;
+    if (!fromZero) a.multiply(x, L.t.data());
+    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            double y[3];
+            for (int q = 0; q < 3; ++q) y[q] = r[3 * i + q] - (fromZero ? 0.0 : L.t[3 * i + q]);
+            const double* d = L.dinv.data() + 9 * i;
+            for (int q = 0; q < 3; ++q) {
+                const double v = w * (d[3 * q] * y[0] + d[3 * q + 1] * y[1] + d[3 * q + 2] * y[2]);
+                x[3 * i + q] = fromZero ? v : x[3 * i + q] + v;
+            }
+        }
+    });
+    return false;
+}
+
+void BlockMultigrid::cycle(int l) {
+    Level& L = mLevels[l];
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    if (l + 1 == static_cast<int>(mLevels.size())) {
+        if (mCoarseOk) {
+            Eigen::Map<VecX>(L.xp, n3) = mCoarseLlt.solve(Eigen::Map<const VecX>(L.rp, n3));
+        } else { // a symmetric pair of sweeps, the first from zero
+            smooth(l, true, true);
+            smooth(l, false, false);
+        }
+        return;
+    }
+    // x = 0 on entry: the first sweep starts from zero and writes every row without reading
+    // its old value, so no fill is needed (only without sweeps).
+    if (mSettings.sweeps < 1) std::fill(L.xp, L.xp + n3, 0.0);
+    // t = r − A x. After one forward Gauss–Seidel sweep from zero, rows up to i already
+    // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j, which that sweep accumulates itself.
+    const BsrMatrix& a = L.a;
+    const bool fused = mSettings.gaussSeidel && mSettings.sweeps == 1;
+    bool pull = false; // t_i = −Σ_{j>i} A_ij x_j still to be pulled, row by row
+    for (int s = 0; s < mSettings.sweeps; ++s) pull = smooth(l, true, s == 0, fused);
+    if (!fused) {
+        a.multiply(L.xp, L.t.data());
+        for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
+    }
+    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
+    Level& C = mLevels[l + 1];
+    if (pull) {
+        const BsrPattern p = a.pattern();
+        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+            bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i0, i1);
+        });
+    }
+    L.P.restrictTo(L.t.data(), C.r.data());
+    cycle(l + 1);
+    // x += α P e.
+    L.P.prolongAdd(C.x.data(), mSettings.coarseWeight, L.xp);
+    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+}
+
+void BlockMultigrid::toLevelOrder(const double* natural, double* level) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                level[3 * p + q] = natural[3 * static_cast<size_t>(mOrder[p]) + q];
+    });
+}
+
+void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                natural[3 * static_cast<size_t>(mOrder[p]) + q] = level[3 * p + q];
+    });
+}
+
+double BlockMultigrid::apply(const double* r, double* z) {
+    // Level 0 reads r and writes x = z in place: no copies in or out.
+    Level& L = mLevels[0];
+    L.rp = r;
+    L.xp = z;
+    cycle(0);
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    return deterministicDot(r, z, 3 * static_cast<size_t>(L.a.n));
+}
+
+} // namespace gale::solver

@@ -1,0 +1,187 @@
+// An aggregation algebraic-multigrid preconditioner for the filtered 3×3-block cloth system
+// (Tamstorf, Jones, McCormick 2015), applied as one symmetric V-cycle per CG iteration, and the
+// block-CSR (BSR) copy of the filtered matrix Â that the multigrid CG multiplies with.
+#pragma once
+
+#include "solver/linalg/bsr_kernels.h"
+#include "solver/linalg/prolongator.h"
+#include "solver/linalg/types.h"
+
+#include <Eigen/Cholesky>
+
+#include <cstdint>
+#include <vector>
+
+namespace gale::solver {
+
+class BlockMatrix;
+struct Constraints;
+
+// How the filtered system is preconditioned inside conjugate gradient.
+enum class Preconditioner { BlockJacobi, Multigrid };
+
+// A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
+// column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
+// zeros (bsr_kernels.h).
+struct BsrMatrix {
+    int n = 0;
+    std::vector<int> start, cols, diag, mirror; // mirror[k]: slot of the transposed block
+    std::vector<double> val;
+
+    int blocks() const { return static_cast<int>(cols.size()); }
+    BsrPattern pattern() const { return {start.data(), cols.data(), diag.data(), n}; }
+    // y = M x, parallel over rows (deterministic: each row is summed in column order).
+    void multiply(const double* x, double* y) const;
+    // y = M x and returns xᵀy, summed in chunks of kReduceChunk entries like deterministicDot
+    // (same bits; one pass over x and y instead of two). `partial` is scratch.
+    // With `single` (these values in float), the product reads those instead of val.
+    double multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single = nullptr) const;
+};
+
+// Smoothed-aggregation AMG (Vaněk, Mandel, Brezina 1996) for the filtered system
+//   Â = S A S + I − S                                        (Tamstorf, Jones, McCormick 2015)
+// with a near-null space B of rigid-body modes filtered by the constraints: for vertex i at x_i
+// in an aggregate with centroid c,
+//   B_i = S_i [ I₃ | −[x_i − c]× / ρ ]   (translations and rotations; ρ the aggregate's radius),
+// or the translations S_i alone when no positions are given (setPositions). Per level:
+//   P_tent = blockdiag(Q_J),  B_J = Q_J R_J  (orthonormalised on each aggregate J),
+//   P = (I − ω D⁻¹ Â) P_tent,  ω = (4/3) / ρ(D⁻¹Â)  (ρ by a few power steps),
+//   A_{l+1} = Pᵀ A_l P,   B_{l+1} = R,
+// so every level holds 6 unknowns per aggregate (two 3×3 block rows; one with translations
+// only). Rows of P lie in range(S_i) by construction (D_i⁻¹ keeps range(S_i)), so the coarse
+// levels never see the constrained directions, whatever the per-vertex filter (I, I − nnᵀ, 0).
+// Coarse unknowns no mode reaches (a fully pinned aggregate, a straight strand's twist) get an
+// identity diagonal and stay zero. Aggregates (a root plus its neighbours, then the rest joined
+// to a neighbouring aggregate) are chosen once per matrix pattern, from the pattern alone, on
+// the graph of nodes (a coarse node's two block rows aggregate together); every later refresh
+// recomputes the values (B, P, ω and the Galerkin products) from the current matrix and
+// positions only, so a resumed run builds the same hierarchy bit for bit. With `smoothed` off
+// and `rotations` off this is plain aggregation with translations (the benchmark's baseline).
+// The V-cycle uses damped block-Jacobi smoothing (ν sweeps before and the same after) or a
+// forward/backward multicolour block Gauss–Seidel pair, and a dense Cholesky on the coarsest
+// level, so the preconditioner is symmetric positive definite.
+//
+// Multicolour ordering (Adams 2001, "A distributed memory unstructured Gauss–Seidel algorithm
+// for multigrid smoothers"; Saad, "Iterative Methods for Sparse Linear Systems" §12.4, here
+// by blocks of rows): each level's rows, in natural order, are cut into blocks of
+// Settings::rowBlock, the blocks coloured greedily in block order so that no two blocks of a
+// colour are coupled, and the level is stored renumbered colour by colour (blocks and rows in
+// natural order within a colour). Gauss–Seidel in that row order is lexicographic inside a
+// block and multicolour between blocks: the blocks of one colour read only the other colours'
+// x, so they are swept in parallel and the result is the same bits on any number of threads
+// (and the same as the one sequential sweep small levels take). The backward sweep visits the
+// colours in reverse, each block backwards: it stays the exact adjoint of the forward one.
+// Whole blocks keep the natural order's memory locality and most of its coupling, so the
+// smoother is nearly as strong as the lexicographic one (bench/README.md). Aggregation visits
+// the rows in their natural order, so the renumbering does not change the aggregates. Vectors
+// passed to apply, multiply and
+// multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder). The smoother reads a
+// single-precision copy of each level's matrix (half the memory traffic; the V-cycle only
+// approximates Â⁻¹ anyway), while conjugate gradient multiplies with Â in double precision.
+class BlockMultigrid {
+public:
+    struct Settings {
+        bool gaussSeidel = true;    // symmetric block Gauss–Seidel, else damped block Jacobi
+        int sweeps = 1;             // smoothing sweeps before and after the coarse correction
+        double jacobiWeight = 0.6;  // ω of damped block Jacobi
+        double coarseWeight = 1.0;  // α: x += α P e (over-correction for plain aggregation)
+        int coarsest = 48;          // stop coarsening at this many block rows
+        int parallelRows = 1024;    // levels with fewer rows sweep sequentially (the same bits)
+        int rowBlock = 128;         // rows per block of the multicolour ordering
+        bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
+                                    // always sequential (the benchmark's baseline)
+        bool smoothed = true;       // P = (I − ω D⁻¹ Â) P_tent; false: P = P_tent (plain)
+        bool rotations = true;      // rotations in the near-null space (when positions are set)
+        double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
+        int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
+    };
+
+    // The settings new instances start with (process-wide, like setWideKernels: change them
+    // only while no solver is being built; the benchmark compares orderings with it).
+    static Settings& defaults();
+
+    Settings& settings() { return mSettings; }
+
+    // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
+    // space; copied. Without them (or with another count) the near-null space is translations.
+    void setPositions(const double* x, int n) { mPositions.assign(x, x + 3 * static_cast<size_t>(n)); }
+
+    // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
+    // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
+    // when a value is not finite.
+    // keepCoarse: only level 0 takes A's values; the coarse levels and prolongators stay those
+    // of the last full refresh (still an SPD preconditioner, for a matrix that changed little:
+    // Newton's iterates, GMRES's repeated solves with one matrix). Ignored when the pattern
+    // or the constrained rows changed.
+    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained,
+                 bool keepCoarse = false);
+    // 3n vectors from A's vertex order to level 0's colour order and back.
+    void toLevelOrder(const double* natural, double* level) const;
+    void fromLevelOrder(const double* level, double* natural) const;
+    // A level's matrix (in its colour order) and its multicolour ordering (its order lists the
+    // natural index of each row).
+    const BsrMatrix& matrix(int level) const { return mLevels[level].a; }
+    const ColouredBlocks& colouring(int level) const { return mLevels[level].colouring; }
+    // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero, written into z
+    // directly; z must not overlap r); returns rᵀz (deterministicDot).
+    double apply(const double* r, double* z);
+    // y = Â x with the level-0 copy.
+    void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
+    // y = Â x and returns xᵀÂx (deterministicDot's summation order); `single`: with the
+    // single-precision copy of Â (half the memory traffic; see FilteredSolver::solvePcgMultigrid).
+    double multiplyDot(const double* x, double* y, bool single) {
+        return mLevels[0].a.multiplyDot(x, y, mPartial, single ? mLevels[0].lowVal.data() : nullptr);
+    }
+
+    int levelCount() const { return static_cast<int>(mLevels.size()); }
+    int rows(int level) const { return mLevels[level].a.n; }
+    // Near-null modes per node of the coarse levels (6 with rotations, else 3).
+    int modes() const { return mModes; }
+    // Bytes held by the hierarchy (matrices, prolongators, work vectors).
+    size_t bytes() const;
+
+private:
+    struct Level {
+        BsrMatrix a;
+        std::vector<float> lowVal;     // a.val in single precision, read by the smoother
+        std::vector<double> dinv;      // 9 per row: inverse diagonal block
+        ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
+        std::vector<int> visit;        // row of each natural index (the aggregation's order)
+        std::vector<double> nullB;     // near-null space: 3×modes per row, column-major
+        std::vector<uint8_t> dead;     // per scalar unknown: no mode reaches it (coarse levels)
+        std::vector<int> graphStart, graphCols; // node graph (colour-order nodes) to aggregate
+        Aggregates agg;                // nodes of this level → nodes of the next (agg.d: rows per node)
+        BlockProlongator P;            // to the next level
+        std::vector<double> Q;         // tentative prolongator: 3×modes per row
+        std::vector<double> r, x, t;   // 3n work vectors
+        const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
+        double* xp = nullptr;
+    };
+
+    void buildHierarchy(const BlockMatrix& A);
+    bool buildCoarse(int l); // false: coarsening stalls
+    void levelZeroNullSpace();
+    void coarsenValues(int l);
+    void finishLevel(int l);
+    // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
+    // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
+    bool smooth(int l, bool forward, bool fromZero, bool residual = false);
+    void cycle(int l);
+
+    Settings mSettings = defaults();
+    std::vector<Level> mLevels;
+    int mPatternRows = -1, mPatternSlots = -1;
+    std::vector<double> mPartial; // chunk sums of the fused dot products
+    std::vector<int> mOrder;      // A's row of each level-0 row
+    std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
+    std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
+    std::vector<double> mNormal;
+    std::vector<double> mPositions; // A's order, for the rotations
+    int mModes = 3;
+    bool mHaveCoarse = false; // the coarse levels hold values (keepCoarse may reuse them)
+    Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
+    Eigen::MatrixXd mCoarseDense;
+    bool mCoarseOk = false;
+};
+
+} // namespace gale::solver
