@@ -23,6 +23,7 @@
 #include <HYPRE.h>
 #include <HYPRE_krylov.h>
 #include <HYPRE_parcsr_ls.h>
+#include <mpi.h>
 #endif
 
 using namespace gale::solver;
@@ -166,7 +167,8 @@ Outcome runHypre(const ClothSystem& s, double tol) {
     HYPRE_BoomerAMGSetTol(amg, 0.0);
     HYPRE_BoomerAMGSetMaxIter(amg, 1);
     HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-    HYPRE_PCGSetPrecond(pcg, HYPRE_BoomerAMGSolve, HYPRE_BoomerAMGSetup, amg);
+    HYPRE_PCGSetPrecond(pcg, reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSolve),
+                        reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSetup), amg);
     HYPRE_ParCSRPCGSetup(pcg, A, pb, px);
     o.setup = since(t0);
     t0 = Clock::now();
@@ -272,12 +274,14 @@ int main(int argc, char** argv) {
         }
     }
 #ifdef GALE_HAVE_HYPRE
+    MPI_Init(&argc, &argv);
     HYPRE_Init();
 #endif
     if (only.empty() || only == "scaling") scalingBench(quick, onlySize);
     if (only.empty() || only == "error") errorBench(quick);
 #ifdef GALE_HAVE_HYPRE
     HYPRE_Finalize();
+    MPI_Finalize();
 #endif
     return 0;
 }
