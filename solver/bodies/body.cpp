@@ -806,6 +806,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         else
             mDv.setZero(3 * n);
         mSolver.setPreconditioner(mOptions.preconditioner);
+        mSolver.multigrid().setKind(mOptions.multigrid);
         // The multigrid's near-null space: rigid-body modes about the substep's start positions.
         mSolver.multigrid().setPositions(x0.data(), static_cast<int>(n));
         ls = solveLinear(mB, mDv);

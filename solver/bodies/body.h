@@ -60,6 +60,10 @@ struct StepOptions {
     LinearSolverKind linearSolver = LinearSolverKind::Pcg;
     Preconditioner preconditioner =
         Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
+    // The multigrid's hierarchy: Automatic takes smoothed aggregation from
+    // BlockMultigrid::Settings::smoothedMinRows block rows up (its set-up pays only there,
+    // bench/README.md) and plain aggregation below; Plain and Smoothed force one.
+    MultigridKind multigrid = MultigridKind::Automatic;
     double cgTolerance = 1e-3;     // relative residual of the filtered system
     int cgMaxIterations = 2000;
     // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):

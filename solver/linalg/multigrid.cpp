@@ -219,6 +219,154 @@ bool BlockMultigrid::buildCoarse(int l) {
     return true;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Plain aggregation (main's path before issue 26, kept bit for bit for small meshes, where the
+// smoothed set-up costs more than its iterations save: bench/README.md): P₀ = S P_tent with
+// P_tent(i, I) = I₃, Galerkin products as sums of blocks.
+
+// Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
+// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit),
+// rows visited in their natural order (fine.visit); builds the pattern of `coarse` — its rows
+// (the aggregates, numbered in the order they were found) coloured and renumbered in colour
+// order — and the slot maps.
+void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
+    const BsrMatrix& a = fine.a;
+    const int n = a.n;
+    std::vector<int> agg(n, -1), size;
+    // 1. Roots: a vertex whose neighbours are all unaggregated starts an aggregate with them.
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
+        if (agg[i] >= 0) continue;
+        bool free = true;
+        for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
+            if (agg[a.cols[k]] >= 0) free = false;
+        if (!free) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) agg[a.cols[k]] = static_cast<int>(size.size());
+        size.push_back(a.start[i + 1] - a.start[i]);
+    }
+    // 2. The rest join the smallest neighbouring aggregate (ties: the lower index), decided
+    // from the phase-1 labels only, so the order of the rows does not matter.
+    std::vector<int> joined = agg;
+    for (int i = 0; i < n; ++i) {
+        if (agg[i] >= 0) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+            const int J = agg[a.cols[k]];
+            if (J >= 0 && (joined[i] < 0 || size[J] < size[joined[i]] || (size[J] == size[joined[i]] && J < joined[i])))
+                joined[i] = J;
+        }
+    }
+    // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
+    int count = static_cast<int>(size.size());
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
+        if (joined[i] >= 0) continue;
+        joined[i] = count;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            if (joined[a.cols[k]] < 0) joined[a.cols[k]] = count;
+        ++count;
+    }
+    // The coarse graph in the aggregates' natural numbering, coloured in that order; coarse
+    // row P is aggregate order[P].
+    std::vector<std::vector<int>> rows(count);
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            rows[joined[i]].push_back(joined[a.cols[k]]);
+    std::vector<int> natStart(count + 1, 0), natCols;
+    for (int I = 0; I < count; ++I) {
+        std::sort(rows[I].begin(), rows[I].end());
+        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
+        natCols.insert(natCols.end(), rows[I].begin(), rows[I].end());
+        natStart[I + 1] = static_cast<int>(natCols.size());
+    }
+    coarse.colouring = colourRows(mSettings.multicolour, mSettings.rowBlock, count, natStart.data(),
+                                  natCols.data());
+    const std::vector<int>& order = coarse.colouring.order;
+    coarse.visit.resize(count);
+    for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
+    fine.plainAgg.resize(n);
+    for (int i = 0; i < n; ++i) fine.plainAgg[i] = coarse.visit[joined[i]];
+    fine.plainStart.assign(count + 1, 0);
+    for (int i = 0; i < n; ++i) ++fine.plainStart[fine.plainAgg[i] + 1];
+    for (int I = 0; I < count; ++I) fine.plainStart[I + 1] += fine.plainStart[I];
+    fine.plainMembers.resize(n);
+    {
+        std::vector<int> fill(fine.plainStart.begin(), fine.plainStart.end() - 1);
+        for (int i = 0; i < n; ++i) fine.plainMembers[fill[fine.plainAgg[i]]++] = i;
+    }
+    // Coarse pattern: (agg i, agg j) for every fine block (i, j), in the coarse numbering.
+    BsrMatrix& c = coarse.a;
+    c.n = count;
+    c.start.assign(count + 1, 0);
+    c.cols.clear();
+    std::vector<int> row;
+    for (int P = 0; P < count; ++P) {
+        row.clear();
+        for (int k = natStart[order[P]]; k < natStart[order[P] + 1]; ++k)
+            row.push_back(coarse.visit[natCols[k]]);
+        std::sort(row.begin(), row.end());
+        c.cols.insert(c.cols.end(), row.begin(), row.end());
+        c.start[P + 1] = static_cast<int>(c.cols.size());
+    }
+    finishPattern(c);
+    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
+    fine.coarseSlot.resize(a.cols.size());
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            fine.coarseSlot[k] = slotIn(c, fine.plainAgg[i], fine.plainAgg[a.cols[k]]);
+    // The same map inverted, for the coarsening's gather: the fine slots of each coarse slot in
+    // increasing order.
+    fine.gatherStart.assign(c.cols.size() + 1, 0);
+    for (int K : fine.coarseSlot) ++fine.gatherStart[K + 1];
+    for (size_t K = 0; K < c.cols.size(); ++K) fine.gatherStart[K + 1] += fine.gatherStart[K];
+    fine.gather.resize(a.cols.size());
+    std::vector<int> fill(fine.gatherStart.begin(), fine.gatherStart.end() - 1);
+    for (int k = 0; k < a.blocks(); ++k) fine.gather[fill[fine.coarseSlot[k]]++] = k;
+}
+
+// A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
+// I − S part and aggregates with a direction no member can move in get an identity there.
+void BlockMultigrid::coarsenPlain(int l) {
+    Level& f = mLevels[l];
+    BsrMatrix& c = mLevels[l + 1].a;
+    const BsrMatrix& a = f.a;
+    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
+    parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
+        for (int K = c.start[I0]; K < c.start[I1]; ++K) {
+            double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+            for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
+                const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
+                for (int q = 0; q < 9; ++q) sum[q] += src[q];
+            }
+            std::copy(sum, sum + 9, c.val.data() + 9 * static_cast<size_t>(K));
+        }
+    });
+    if (l != 0 || mKind.empty()) return;
+    for (int i = 0; i < a.n; ++i) {
+        if (!mKind[i]) continue;
+        // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
+        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
+            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+    }
+    for (int I = 0; I < c.n; ++I) {
+        bool any = false;
+        for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) any = any || mKind[f.plainMembers[m]];
+        if (!any) continue;
+        Mat3 B = Mat3::Zero();
+        for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) {
+            const int i = f.plainMembers[m];
+            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+        }
+        Eigen::SelfAdjointEigenSolver<Mat3> es(B);
+        BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
+        const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
+        for (int e = 0; e < 3; ++e)
+            if (es.eigenvalues()[e] < 1e-8) {
+                const Vec3 v = es.eigenvectors().col(e);
+                d += scale * v * v.transpose();
+            }
+    }
+}
+
 // Level 0's near-null space from the positions and filters (multigrid.h): per aggregate its
 // centroid and radius, per row S_i [I | −[x_i − c]× / ρ].
 void BlockMultigrid::levelZeroNullSpace() {
@@ -326,6 +474,7 @@ size_t BlockMultigrid::bytes() const {
         v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
         v(L.nullB), v(L.dead), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
         v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot), v(L.Q);
+        v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
         v(L.r), v(L.x), v(L.t);
     }
     v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
@@ -335,15 +484,19 @@ size_t BlockMultigrid::bytes() const {
 
 bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained,
                              bool keepCoarse) {
-    const int modes = mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
+    const bool plain = !mSettings.smoothed || A.size() < mSettings.smoothedMinRows;
+    const int modes =
+        !plain && mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
     const bool fresh = mLevels.empty() || mPatternRows != A.size() ||
-                       mPatternSlots != A.slotCount() || modes != mModes;
+                       mPatternSlots != A.slotCount() || modes != mModes || plain != mPlain;
     mModes = modes;
+    mPlain = plain;
+    if (plain) keepCoarse = false; // its set-up is cheap: always the matrix's own hierarchy
     std::vector<uint8_t> kindsBefore;
     if (keepCoarse && !fresh) kindsBefore = mKind;
     if (fresh) {
         buildHierarchy(A);
-        while (mLevels.back().a.n > mSettings.coarsest &&
+        while (!plain && mLevels.back().a.n > mSettings.coarsest &&
                buildCoarse(static_cast<int>(mLevels.size()) - 1)) {
         }
     }
@@ -411,10 +564,30 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
     // one's values from it.
     const bool reuse = keepCoarse && !fresh && kindsBefore == mKind && mHaveCoarse;
-    for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
-        finishLevel(l);
-        if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
-        if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
+    if (plain) {
+        // Plain aggregation: aggregate on first sight of the pattern, then sum.
+        for (int l = 0;; ++l) {
+            if (fresh) {
+                if (mLevels[l].a.n <= mSettings.coarsest) break;
+                Level next;
+                aggregatePlain(mLevels[l], next);
+                if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
+                    mLevels[l].plainAgg.clear();
+                    break;
+                }
+                mLevels.push_back(std::move(next));
+            } else if (l + 1 >= static_cast<int>(mLevels.size())) {
+                break;
+            }
+            coarsenPlain(l);
+        }
+        for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) finishLevel(l);
+    } else {
+        for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
+            finishLevel(l);
+            if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
+            if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
+        }
     }
     mHaveCoarse = true;
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
@@ -483,6 +656,42 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     return false;
 }
 
+// Plain aggregation's coarse correction: r_c = P₀ᵀ t, the coarse cycle, x += α P₀ e (P₀ = S P_tent
+// at level 0, P_tent below).
+void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    Level& L = mLevels[l];
+    Level& C = mLevels[l + 1];
+    const BsrMatrix& a = L.a;
+    const BsrPattern p = a.pattern();
+    const bool filtered = l == 0 && !mKind.empty();
+    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
+        for (size_t I = I0; I < I1; ++I) {
+            Vec3 s = Vec3::Zero();
+            for (int m = L.plainStart[I]; m < L.plainStart[I + 1]; ++m) {
+                const int i = L.plainMembers[m];
+                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
+                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
+                if (filtered && mKind[i])
+                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                s += t;
+            }
+            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
+        }
+    });
+    cycle(l + 1);
+    // x += α S P_tent e.
+    const double alpha = mSettings.coarseWeight;
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const int I = L.plainAgg[i];
+            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
+        }
+    });
+}
+
 void BlockMultigrid::cycle(int l) {
     Level& L = mLevels[l];
     const size_t n3 = 3 * static_cast<size_t>(L.a.n);
@@ -508,8 +717,13 @@ void BlockMultigrid::cycle(int l) {
         a.multiply(L.xp, L.t.data());
         for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
     }
-    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
     Level& C = mLevels[l + 1];
+    if (mPlain) {
+        cyclePlainCoarse(l, pull);
+        for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+        return;
+    }
+    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
     if (pull) {
         const BsrPattern p = a.pattern();
         parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {

@@ -19,6 +19,8 @@ struct Constraints;
 
 // How the filtered system is preconditioned inside conjugate gradient.
 enum class Preconditioner { BlockJacobi, Multigrid };
+// Which multigrid hierarchy (BlockMultigrid::Settings::smoothed, smoothedMinRows).
+enum class MultigridKind { Automatic, Plain, Smoothed };
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
 // column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
@@ -90,7 +92,12 @@ public:
         int rowBlock = 128;         // rows per block of the multicolour ordering
         bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
                                     // always sequential (the benchmark's baseline)
-        bool smoothed = true;       // P = (I − ω D⁻¹ Â) P_tent; false: P = P_tent (plain)
+        // Smoothed aggregation with the rigid-body near-null space from this many block rows
+        // of A up; below (and with `smoothed` off) plain aggregation with translations,
+        // P = S P_tent, bit for bit the path before issue 26: its set-up is cheap and on small
+        // meshes costs less than the iterations smoothing saves (bench/README.md, crossover).
+        bool smoothed = true;
+        int smoothedMinRows = 12000;
         bool rotations = true;      // rotations in the near-null space (when positions are set)
         double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
         int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
@@ -101,6 +108,11 @@ public:
     static Settings& defaults();
 
     Settings& settings() { return mSettings; }
+    // Sets smoothed and smoothedMinRows for `kind` (Automatic: the defaults' threshold).
+    void setKind(MultigridKind kind) {
+        mSettings.smoothed = kind != MultigridKind::Plain;
+        mSettings.smoothedMinRows = kind == MultigridKind::Automatic ? defaults().smoothedMinRows : 0;
+    }
 
     // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
     // space; copied. Without them (or with another count) the near-null space is translations.
@@ -137,6 +149,8 @@ public:
     int rows(int level) const { return mLevels[level].a.n; }
     // Near-null modes per node of the coarse levels (6 with rotations, else 3).
     int modes() const { return mModes; }
+    // The hierarchy in use is plain aggregation (Settings::smoothed, smoothedMinRows).
+    bool plain() const { return mPlain; }
     // Bytes held by the hierarchy (matrices, prolongators, work vectors).
     size_t bytes() const;
 
@@ -153,6 +167,9 @@ private:
         Aggregates agg;                // nodes of this level → nodes of the next (agg.d: rows per node)
         BlockProlongator P;            // to the next level
         std::vector<double> Q;         // tentative prolongator: 3×modes per row
+        // Plain aggregation only (aggregatePlain): the aggregate of each row, the rows of each
+        // aggregate, the next level's slot of each slot and its inverse (the slots summed).
+        std::vector<int> plainAgg, plainStart, plainMembers, coarseSlot, gatherStart, gather;
         std::vector<double> r, x, t;   // 3n work vectors
         const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
         double* xp = nullptr;
@@ -162,11 +179,14 @@ private:
     bool buildCoarse(int l); // false: coarsening stalls
     void levelZeroNullSpace();
     void coarsenValues(int l);
+    void aggregatePlain(Level& fine, Level& coarse);
+    void coarsenPlain(int l);
     void finishLevel(int l);
     // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
     // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
+    void cyclePlainCoarse(int l, bool pull);
 
     Settings mSettings = defaults();
     std::vector<Level> mLevels;
@@ -178,6 +198,7 @@ private:
     std::vector<double> mNormal;
     std::vector<double> mPositions; // A's order, for the rotations
     int mModes = 3;
+    bool mPlain = false;
     bool mHaveCoarse = false; // the coarse levels hold values (keepCoarse may reuse them)
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
     Eigen::MatrixXd mCoarseDense;

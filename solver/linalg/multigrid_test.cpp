@@ -304,22 +304,30 @@ struct MgRun {
     bool converged = false;
     VecX dv;
     int modes = 0;
+    bool plain = false;
 };
 
-MgRun solveMg(const ClothSystem& s, double tol, bool smoothed, bool rotations, int threads = 1) {
+// smoothed: smoothed aggregation whatever the size (smoothedMinRows 0), else plain aggregation;
+// automatic: the default choice by size.
+MgRun solveMg(const ClothSystem& s, double tol, bool smoothed, bool rotations, int threads = 1,
+              bool automatic = false) {
     MgRun out;
     tbb::task_arena arena(threads);
     arena.execute([&] {
         FilteredSolver mg;
         mg.setPreconditioner(Preconditioner::Multigrid);
-        mg.multigrid().settings().smoothed = smoothed;
-        mg.multigrid().settings().rotations = rotations;
+        if (!automatic) {
+            mg.multigrid().settings().smoothed = smoothed;
+            mg.multigrid().settings().smoothedMinRows = 0;
+            mg.multigrid().settings().rotations = rotations;
+        }
         mg.multigrid().setPositions(s.x.data(), s.A.size());
         out.dv = VecX::Zero(s.b.size());
         const SolveStatus st = mg.solve(s.A, s.c, s.b, out.dv, LinearSolverKind::Pcg, tol, 1000);
         out.iterations = st.iterations;
         out.converged = st.converged;
         out.modes = mg.multigrid().modes();
+        out.plain = mg.multigrid().plain();
     });
     return out;
 }
@@ -368,6 +376,31 @@ TEST_CASE("multigrid: smoothed-aggregation iterations stay bounded from 32x32 to
             CHECK(sa.back() < plain.back());
             CHECK(plain[1] >= 2.5 * plain[0]);
         }
+}
+
+TEST_CASE("multigrid: by default plain aggregation below smoothedMinRows, smoothed from there up",
+          "[multigrid]") {
+    const int threshold = BlockMultigrid::defaults().smoothedMinRows;
+    REQUIRE(threshold > 0);
+    const int below = static_cast<int>(std::floor(std::sqrt(threshold))) - 2; // (n+1)² < threshold
+    const int above = static_cast<int>(std::ceil(std::sqrt(threshold)));      // (n+1)² > threshold
+    const ClothSystem small = makeClothSystem(below, 1.0 / 24.0, false, true);
+    const ClothSystem large = makeClothSystem(above, 1.0 / 24.0, false, true);
+    REQUIRE(small.A.size() < threshold);
+    REQUIRE(large.A.size() >= threshold);
+    const MgRun a = solveMg(small, 1e-6, true, true, 1, true);
+    const MgRun b = solveMg(large, 1e-6, true, true, 1, true);
+    REQUIRE(a.converged);
+    REQUIRE(b.converged);
+    CHECK(a.plain);
+    CHECK(a.modes == 3);
+    CHECK_FALSE(b.plain);
+    CHECK(b.modes == 6);
+    // The automatic choice below the threshold is the forced plain path, bit for bit.
+    const MgRun forced = solveMg(small, 1e-6, false, false, 1);
+    CHECK(forced.plain);
+    CHECK(forced.iterations == a.iterations);
+    CHECK((forced.dv - a.dv).cwiseAbs().maxCoeff() == 0.0);
 }
 
 TEST_CASE("multigrid: smoothed aggregation gives the same bits on 1 and 2 threads", "[multigrid]") {
