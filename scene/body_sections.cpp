@@ -34,7 +34,7 @@ constexpr long long kMaxGridVertices = 1LL << 20;
 
 // The keys of the step options (Loader::stepOptions), shared by cloth and hair.
 std::vector<std::string> withStepKeys(std::vector<std::string> keys) {
-    for (const char* k : {"pins", "linear_solver", "preconditioner", "cg_tolerance", "cg_max_iterations",
+    for (const char* k : {"pins", "linear_solver", "preconditioner", "multigrid", "cg_tolerance", "cg_max_iterations",
                           "newton_iterations", "newton_tolerance", "output"})
         keys.push_back(k);
     return keys;
@@ -376,6 +376,13 @@ void Loader::stepOptions(const toml::table& t, const std::string& what, StepOpti
         std::string v;
         if (choice(*n, "preconditioner", {"multigrid", "jacobi"}, v))
             s.preconditioner = v == "jacobi" ? Preconditioner::BlockJacobi : Preconditioner::Multigrid;
+    }
+    if (const toml::node* n = t.get("multigrid")) {
+        std::string v;
+        if (choice(*n, "multigrid", {"auto", "plain", "smoothed"}, v))
+            s.multigrid = v == "plain"      ? MultigridKind::Plain
+                          : v == "smoothed" ? MultigridKind::Smoothed
+                                            : MultigridKind::Automatic;
     }
     if (const toml::node* n = t.get("cg_tolerance")) number(*n, what + ": cg_tolerance", s.cgTolerance, 0.0, true);
     if (const toml::node* n = t.get("cg_max_iterations")) {

@@ -629,8 +629,10 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
         int k = 0;
         for (int j = 0; j < kGmresRestart; ++j) {
             Z[j].setZero(n3);
+            mSolver.setKeepCoarse(true); // the same matrix as the solve above
             const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver,
                                                  precTolerance, mOptions.cgMaxIterations);
+            mSolver.setKeepCoarse(false);
             ls.iterations += ps.iterations;
             if (ps.failed || !Z[j].allFinite()) {
                 failed = true;
@@ -804,7 +806,15 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         }
         if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
             mDv = dvBase;
-            energy = elasticAt(x0 + h * v0 + mYPos, t1, mFel);
+            // ... or, when x₀ + h v₀ itself over-stretches (a fast incoming velocity), from
+            // the free directions at rest (x₁ = x₀, feasible by the detector's rule) and the
+            // constrained ones as prescribed: every later iterate must stay feasible too.
+            if (!stretchFeasible(x0 + h * v0 + mYPos)) {
+                VecX d = -v0 - dvLin;
+                mConstraints.apply(d.data());
+                mDv = dvLin + d;
+            }
+            energy = elasticAt(x0 + h * (v0 + mDv) + mYPos, t1, mFel);
             break;
         }
         alpha *= 0.5;
@@ -824,7 +834,10 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         mGk = mF - mFel;
         rhs = -mG;
         delta.setZero();
+        // (Options::newtonKeepCoarse: the linearised step's coarse levels, level 0 refreshed.)
+        mSolver.setKeepCoarse(mOptions.newtonKeepCoarse);
         const SolveStatus ns = solveLinear(rhs, delta);
+        mSolver.setKeepCoarse(false);
         st.iterations += ns.iterations;
         st.residual = std::max(st.residual, ns.residual);
         ++st.newtonIterations;
@@ -1012,6 +1025,9 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         else
             mDv.setZero(3 * n);
         mSolver.setPreconditioner(mOptions.preconditioner);
+        mSolver.multigrid().setKind(mOptions.multigrid);
+        // The multigrid's near-null space: rigid-body modes about the substep's start positions.
+        mSolver.multigrid().setPositions(x0.data(), static_cast<int>(n));
         contactRhs(h);
         ls = solveLinear(mBc, mDv);
         // The contact active set: release what pulls, add what ends the step inside, solve

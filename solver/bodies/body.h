@@ -63,6 +63,10 @@ struct StepOptions {
     LinearSolverKind linearSolver = LinearSolverKind::Pcg;
     Preconditioner preconditioner =
         Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
+    // The multigrid's hierarchy: Automatic takes smoothed aggregation from
+    // BlockMultigrid::Settings::smoothedMinRows block rows up (its set-up pays only there,
+    // bench/README.md) and plain aggregation below; Plain and Smoothed force one.
+    MultigridKind multigrid = MultigridKind::Automatic;
     double cgTolerance = 1e-3;     // relative residual of the filtered system
     int cgMaxIterations = 2000;
     // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):
@@ -75,6 +79,10 @@ struct StepOptions {
     // with each triangle (∂F/∂x) and the parts of ∂F/∂v the symmetric damping drops, by GMRES.
     // Off: the SPD linearisation of every iterate (cheaper; no quadratic convergence).
     bool newtonFullJacobian = true;
+    // Newton's solves keep the multigrid's coarse levels from the substep's linearised solve
+    // (only level 0 takes each iterate's matrix). Off: measured on the wind-onset flag the
+    // iterates' matrices are far from the linearised one (CG 17 → 275 iterations per solve).
+    bool newtonKeepCoarse = false;
     bool warmStart = true; // start CG from the previous substep's Δv
     // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
     // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).

@@ -362,7 +362,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     const size_t n3 = 3 * static_cast<size_t>(A.size());
     const double rhsNorm = std::sqrt(deterministicDot(rhsNatural.data(), rhsNatural.data(), n3));
     if (trivialRhs(rhsNorm, yNatural, st)) return st;
-    if (!mMultigrid.refresh(A, c, mConstrained)) {
+    if (!mMultigrid.refresh(A, c, mConstrained, mKeepCoarse)) {
         st.failed = true;
         return st;
     }

@@ -124,6 +124,9 @@ public:
     void setPreconditioner(Preconditioner p) { mPreconditioner = p; }
     Preconditioner preconditioner() const { return mPreconditioner; }
     BlockMultigrid& multigrid() { return mMultigrid; }
+    // Multigrid only: the next solves refresh level 0 alone and keep the coarse levels
+    // (BlockMultigrid::refresh's keepCoarse) — for solves with the same or a nearby matrix.
+    void setKeepCoarse(bool keep) { mKeepCoarse = keep; }
 
     SolveStatus solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
                       LinearSolverKind kind, double tolerance, int maxIterations);
@@ -139,6 +142,7 @@ private:
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
     Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
+    bool mKeepCoarse = false;
     BlockMultigrid mMultigrid;
     VecX mTmp2, mR, mZ, mP, mQ;
     VecX mRhsLevel, mYLevel; // multigrid PCG's rhs and y in the multigrid's level-0 order

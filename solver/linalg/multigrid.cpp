@@ -134,12 +134,102 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     mPatternSlots = A.slotCount();
 }
 
+// The pattern of level l + 1 from level l's: nodes (agg.d rows each) aggregated on the node
+// graph in natural order (fine.visit), P's pattern and the Galerkin pattern in the aggregates'
+// natural numbering, which is then coloured; everything is renumbered in the coarse colour
+// order. Block boundaries of the colouring are multiples of the rows per node, so a coarse
+// node's rows stay consecutive there.
+bool BlockMultigrid::buildCoarse(int l) {
+    Level& f = mLevels[l];
+    const BsrMatrix& a = f.a;
+    const int d = f.agg.d, dc = mModes / 3;
+    const int nodes = a.n / d;
+    std::vector<int> row, nodeVisit(nodes);
+    if (l == 0) { // level 0's node graph: A's pattern
+        f.graphStart.assign(a.start.begin(), a.start.end());
+        f.graphCols.assign(a.cols.begin(), a.cols.end());
+    }
+    const std::vector<int>& nStart = f.graphStart;
+    const std::vector<int>& nCols = f.graphCols;
+    for (int s = 0; s < nodes; ++s) nodeVisit[s] = f.visit[s * d] / d;
+    std::vector<int> joined;
+    const int count = aggregateNodes(nodes, nStart.data(), nCols.data(), nodeVisit, joined);
+    if (5 * static_cast<long>(count) * dc > 4 * static_cast<long>(a.n)) return false; // stalls
+    Aggregates& g = f.agg;
+    g.nodeAgg = joined;
+    g.memberStart.assign(count + 1, 0); // (natural numbering: only the count matters here)
+    BlockProlongator& P = f.P;
+    prolongatorPattern(a, g, dc, mSettings.smoothed, P);
+    P.buildTranspose();
+    std::vector<int> natStart, natCols;
+    galerkinPattern(a, P, natStart, natCols);
+    const int nc = dc * count;
+    Level c;
+    const int block = (std::max(mSettings.rowBlock, 1) + dc - 1) / dc * dc;
+    c.colouring = colourRows(mSettings.multicolour, block, nc, natStart.data(), natCols.data());
+    const std::vector<int>& order = c.colouring.order;
+    c.visit.resize(nc);
+    for (int p = 0; p < nc; ++p) c.visit[order[p]] = p;
+    c.agg.d = dc;
+    // Renumber: nodes, P's columns (rows re-sorted), members, the coarse pattern.
+    for (int u = 0; u < nodes; ++u) g.nodeAgg[u] = c.visit[joined[u] * dc] / dc;
+    for (int r = 0; r < a.n; ++r) {
+        for (int k = P.start[r]; k < P.start[r + 1]; ++k) P.cols[k] = c.visit[P.cols[k]];
+        std::sort(P.cols.begin() + P.start[r], P.cols.begin() + P.start[r + 1]);
+    }
+    P.buildTranspose();
+    g.memberStart.assign(count + 1, 0);
+    for (int u = 0; u < nodes; ++u) ++g.memberStart[g.nodeAgg[u] + 1];
+    for (int J = 0; J < count; ++J) g.memberStart[J + 1] += g.memberStart[J];
+    g.members.resize(nodes);
+    {
+        std::vector<int> fill(g.memberStart.begin(), g.memberStart.end() - 1);
+        for (int u = 0; u < nodes; ++u) g.members[fill[g.nodeAgg[u]]++] = u;
+    }
+    BsrMatrix& cm = c.a;
+    cm.n = nc;
+    cm.start.assign(nc + 1, 0);
+    cm.cols.clear();
+    for (int p = 0; p < nc; ++p) {
+        row.clear();
+        for (int k = natStart[order[p]]; k < natStart[order[p] + 1]; ++k) row.push_back(c.visit[natCols[k]]);
+        std::sort(row.begin(), row.end());
+        cm.cols.insert(cm.cols.end(), row.begin(), row.end());
+        cm.start[p + 1] = static_cast<int>(cm.cols.size());
+    }
+    finishPattern(cm);
+    cm.val.assign(9 * cm.cols.size() + kBsrPad, 0.0);
+    // The coarse node graph the next aggregation reads: aggregates neighbour when two of their
+    // nodes do (the tentative prolongator's pattern, not the smoothed one's wider stencil: that
+    // would grow the aggregates about threefold per level and coarsen too fast).
+    c.graphStart.assign(count + 1, 0);
+    c.graphCols.clear();
+    for (int J = 0; J < count; ++J) {
+        row.clear();
+        for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+            const int u = g.members[t];
+            for (int k = nStart[u]; k < nStart[u + 1]; ++k) row.push_back(g.nodeAgg[nCols[k]]);
+        }
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        c.graphCols.insert(c.graphCols.end(), row.begin(), row.end());
+        c.graphStart[J + 1] = static_cast<int>(c.graphCols.size());
+    }
+    mLevels.push_back(std::move(c));
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plain aggregation (main's path before issue 26, kept bit for bit for small meshes, where the
+// smoothed set-up costs more than its iterations save: bench/README.md): P₀ = S P_tent with
+// P_tent(i, I) = I₃, Galerkin products as sums of blocks.
+
 // Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
 // read: a resumed run, which sees other first values, builds the same hierarchy bit for bit),
 // rows visited in their natural order (fine.visit); builds the pattern of `coarse` — its rows
 // (the aggregates, numbered in the order they were found) coloured and renumbered in colour
 // order — and the slot maps.
-void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
+void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
     const BsrMatrix& a = fine.a;
     const int n = a.n;
     std::vector<int> agg(n, -1), size;
@@ -193,15 +283,15 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
     const std::vector<int>& order = coarse.colouring.order;
     coarse.visit.resize(count);
     for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
-    fine.agg.resize(n);
-    for (int i = 0; i < n; ++i) fine.agg[i] = coarse.visit[joined[i]];
-    fine.memberStart.assign(count + 1, 0);
-    for (int i = 0; i < n; ++i) ++fine.memberStart[fine.agg[i] + 1];
-    for (int I = 0; I < count; ++I) fine.memberStart[I + 1] += fine.memberStart[I];
-    fine.members.resize(n);
+    fine.plainAgg.resize(n);
+    for (int i = 0; i < n; ++i) fine.plainAgg[i] = coarse.visit[joined[i]];
+    fine.plainStart.assign(count + 1, 0);
+    for (int i = 0; i < n; ++i) ++fine.plainStart[fine.plainAgg[i] + 1];
+    for (int I = 0; I < count; ++I) fine.plainStart[I + 1] += fine.plainStart[I];
+    fine.plainMembers.resize(n);
     {
-        std::vector<int> fill(fine.memberStart.begin(), fine.memberStart.end() - 1);
-        for (int i = 0; i < n; ++i) fine.members[fill[fine.agg[i]]++] = i;
+        std::vector<int> fill(fine.plainStart.begin(), fine.plainStart.end() - 1);
+        for (int i = 0; i < n; ++i) fine.plainMembers[fill[fine.plainAgg[i]]++] = i;
     }
     // Coarse pattern: (agg i, agg j) for every fine block (i, j), in the coarse numbering.
     BsrMatrix& c = coarse.a;
@@ -222,7 +312,7 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
     fine.coarseSlot.resize(a.cols.size());
     for (int i = 0; i < n; ++i)
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
-            fine.coarseSlot[k] = slotIn(c, fine.agg[i], fine.agg[a.cols[k]]);
+            fine.coarseSlot[k] = slotIn(c, fine.plainAgg[i], fine.plainAgg[a.cols[k]]);
     // The same map inverted, for the coarsening's gather: the fine slots of each coarse slot in
     // increasing order.
     fine.gatherStart.assign(c.cols.size() + 1, 0);
@@ -235,7 +325,7 @@ void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
 
 // A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
 // I − S part and aggregates with a direction no member can move in get an identity there.
-void BlockMultigrid::coarsen(int l) {
+void BlockMultigrid::coarsenPlain(int l) {
     Level& f = mLevels[l];
     BsrMatrix& c = mLevels[l + 1].a;
     const BsrMatrix& a = f.a;
@@ -254,16 +344,16 @@ void BlockMultigrid::coarsen(int l) {
     for (int i = 0; i < a.n; ++i) {
         if (!mKind[i]) continue;
         // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
-        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.agg[i]])) -=
+        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
             Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
     }
     for (int I = 0; I < c.n; ++I) {
         bool any = false;
-        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) any = any || mKind[f.members[m]];
+        for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) any = any || mKind[f.plainMembers[m]];
         if (!any) continue;
         Mat3 B = Mat3::Zero();
-        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) {
-            const int i = f.members[m];
+        for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) {
+            const int i = f.plainMembers[m];
             B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
         }
         Eigen::SelfAdjointEigenSolver<Mat3> es(B);
@@ -277,9 +367,139 @@ void BlockMultigrid::coarsen(int l) {
     }
 }
 
-bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained) {
-    const bool fresh = mLevels.empty() || mPatternRows != A.size() || mPatternSlots != A.slotCount();
-    if (fresh) buildHierarchy(A);
+// Level 0's near-null space from the positions and filters (multigrid.h): per aggregate its
+// centroid and radius, per row S_i [I | −[x_i − c]× / ρ].
+void BlockMultigrid::levelZeroNullSpace() {
+    Level& L = mLevels[0];
+    const Aggregates& g = L.agg;
+    const int m = mModes;
+    const size_t stride = 3 * static_cast<size_t>(m);
+    L.nullB.assign(stride * L.a.n, 0.0);
+    const int count = static_cast<int>(g.memberStart.size()) - 1;
+    parallelChunks(static_cast<size_t>(count), 64, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J) {
+            Vec3 c = Vec3::Zero();
+            double radius = 0.0;
+            if (m == 6) {
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    c += vec3At(mPositions.data(), mOrder[g.members[t]]);
+                c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
+                for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                    radius = std::max(radius, (vec3At(mPositions.data(), mOrder[g.members[t]]) - c).norm());
+            }
+            const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
+            for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
+                const int i = g.members[t];
+                const Mat3 S = mKind.empty() ? Mat3::Identity()
+                                             : Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+                double* B = L.nullB.data() + stride * i;
+                BlockMap translations(B);
+                translations = S;
+                if (m == 6) {
+                    const Vec3 p = inv * (vec3At(mPositions.data(), mOrder[i]) - c);
+                    Mat3 cross;
+                    cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
+                    BlockMap(B + 9) = -S * cross;
+                }
+            }
+        }
+    });
+}
+
+// A_{l+1} = P_lᵀ A_l P_l with P_l the smoothed tentative prolongator of B_l (multigrid.h);
+// coarse unknowns no mode reaches get a unit diagonal (their rows and columns are zero).
+void BlockMultigrid::coarsenValues(int l) {
+    Level& f = mLevels[l];
+    Level& c = mLevels[l + 1];
+    if (l == 0) levelZeroNullSpace();
+    double omega = 0.0;
+    if (mSettings.smoothed) {
+        const double rho = spectralRadiusDinvA(f.a, f.dinv.data(), mSettings.powerIterations);
+        omega = mSettings.prolongatorDamping / rho;
+    }
+    tentativeProlongator(f.agg, mModes, f.nullB, f.Q, c.nullB, c.dead);
+    smoothProlongator(f.a, f.agg, mModes / 3, omega, f.Q, f.P);
+    galerkinValues(f.a, f.P, c.a);
+    for (int J = 0; J < c.a.n; ++J) {
+        const uint8_t* dead = c.dead.data() + 3 * static_cast<size_t>(J);
+        if (!(dead[0] | dead[1] | dead[2])) continue;
+        BlockMap D(c.a.val.data() + 9 * static_cast<size_t>(c.a.diag[J]));
+        double live = 0.0;
+        int nLive = 0;
+        for (int q = 0; q < 3; ++q)
+            if (!dead[q]) {
+                live += D(q, q);
+                ++nLive;
+            }
+        const double scale = nLive > 0 && live > 0.0 ? live / nLive : 1.0;
+        for (int q = 0; q < 3; ++q)
+            if (dead[q]) D(q, q) = scale;
+    }
+}
+
+// A level's single-precision copy (level 0's is made by refresh), diagonal inverses and work
+// vectors.
+void BlockMultigrid::finishLevel(int l) {
+    Level& L = mLevels[l];
+    if (l != 0) {
+        L.lowVal.resize(L.a.val.size());
+        parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+        });
+    }
+    L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
+    std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
+    // The inverse of the single-precision diagonal, so that every sweep reads one matrix
+    // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+            BlockMap(L.dinv.data() + 9 * i) =
+                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
+        }
+    });
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    L.r.resize(n3);
+    L.x.resize(n3);
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    L.t.resize(n3);
+}
+
+size_t BlockMultigrid::bytes() const {
+    size_t b = 0;
+    auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
+    for (const Level& L : mLevels) {
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.mirror), v(L.a.val), v(L.lowVal), v(L.dinv);
+        v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
+        v(L.nullB), v(L.dead), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
+        v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot), v(L.Q);
+        v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
+        v(L.r), v(L.x), v(L.t);
+    }
+    v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
+    b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double);
+    return b;
+}
+
+bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained,
+                             bool keepCoarse) {
+    const bool plain = !mSettings.smoothed || A.size() < mSettings.smoothedMinRows;
+    const int modes =
+        !plain && mSettings.rotations && mPositions.size() == 3 * static_cast<size_t>(A.size()) ? 6 : 3;
+    const bool fresh = mLevels.empty() || mPatternRows != A.size() ||
+                       mPatternSlots != A.slotCount() || modes != mModes || plain != mPlain;
+    mModes = modes;
+    mPlain = plain;
+    if (plain) keepCoarse = false; // its set-up is cheap: always the matrix's own hierarchy
+    std::vector<uint8_t> kindsBefore;
+    if (keepCoarse && !fresh) kindsBefore = mKind;
+    if (fresh) {
+        buildHierarchy(A);
+        while (!plain && mLevels.back().a.n > mSettings.coarsest &&
+               buildCoarse(static_cast<int>(mLevels.size()) - 1)) {
+        }
+    }
     // Level 0: Â = S A S + I − S.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
@@ -341,47 +561,35 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             lower(a.diag[i]);
         }
     }
-    // Coarse levels: aggregate on first sight of the pattern, then sum.
-    for (int l = 0;; ++l) {
-        if (fresh) {
-            if (mLevels[l].a.n <= mSettings.coarsest) break;
-            Level next;
-            aggregate(mLevels[l], next);
-            if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
-                mLevels[l].agg.clear();
+    // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
+    // one's values from it.
+    const bool reuse = keepCoarse && !fresh && kindsBefore == mKind && mHaveCoarse;
+    if (plain) {
+        // Plain aggregation: aggregate on first sight of the pattern, then sum.
+        for (int l = 0;; ++l) {
+            if (fresh) {
+                if (mLevels[l].a.n <= mSettings.coarsest) break;
+                Level next;
+                aggregatePlain(mLevels[l], next);
+                if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
+                    mLevels[l].plainAgg.clear();
+                    break;
+                }
+                mLevels.push_back(std::move(next));
+            } else if (l + 1 >= static_cast<int>(mLevels.size())) {
                 break;
             }
-            mLevels.push_back(std::move(next));
-        } else if (l + 1 >= static_cast<int>(mLevels.size())) {
-            break;
+            coarsenPlain(l);
         }
-        coarsen(l);
-    }
-    for (Level& L : mLevels) {
-        if (&L != &mLevels[0]) { // level 0's copy was made above
-            L.lowVal.resize(L.a.val.size());
-            parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
-                for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
-            });
+        for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) finishLevel(l);
+    } else {
+        for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
+            finishLevel(l);
+            if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
+            if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
         }
-        L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
-        std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
-        // The inverse of the single-precision diagonal, so that every sweep reads one matrix
-        // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
-        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-            for (size_t i = i0; i < i1; ++i) {
-                const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
-                BlockMap(L.dinv.data() + 9 * i) =
-                    invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
-            }
-        });
-        const size_t n3 = 3 * static_cast<size_t>(L.a.n);
-        L.r.resize(n3);
-        L.x.resize(n3);
-        L.rp = L.r.data();
-        L.xp = L.x.data();
-        L.t.resize(n3);
     }
+    mHaveCoarse = true;
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
     // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
     const BsrMatrix& c = mLevels.back().a;
@@ -448,6 +656,42 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     return false;
 }
 
+// Plain aggregation's coarse correction: r_c = P₀ᵀ t, the coarse cycle, x += α P₀ e (P₀ = S P_tent
+// at level 0, P_tent below).
+void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    Level& L = mLevels[l];
+    Level& C = mLevels[l + 1];
+    const BsrMatrix& a = L.a;
+    const BsrPattern p = a.pattern();
+    const bool filtered = l == 0 && !mKind.empty();
+    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
+        for (size_t I = I0; I < I1; ++I) {
+            Vec3 s = Vec3::Zero();
+            for (int m = L.plainStart[I]; m < L.plainStart[I + 1]; ++m) {
+                const int i = L.plainMembers[m];
+                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
+                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
+                if (filtered && mKind[i])
+                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                s += t;
+            }
+            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
+        }
+    });
+    cycle(l + 1);
+    // x += α S P_tent e.
+    const double alpha = mSettings.coarseWeight;
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const int I = L.plainAgg[i];
+            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
+        }
+    });
+}
+
 void BlockMultigrid::cycle(int l) {
     Level& L = mLevels[l];
     const size_t n3 = 3 * static_cast<size_t>(L.a.n);
@@ -473,35 +717,23 @@ void BlockMultigrid::cycle(int l) {
         a.multiply(L.xp, L.t.data());
         for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
     }
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
     Level& C = mLevels[l + 1];
-    const BsrPattern p = a.pattern();
-    const bool filtered = l == 0 && !mKind.empty();
-    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
-        for (size_t I = I0; I < I1; ++I) {
-            Vec3 s = Vec3::Zero();
-            for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
-                const int i = L.members[m];
-                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
-                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i])
-                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
-                s += t;
-            }
-            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
-        }
-    });
+    if (mPlain) {
+        cyclePlainCoarse(l, pull);
+        for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+        return;
+    }
+    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
+    if (pull) {
+        const BsrPattern p = a.pattern();
+        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+            bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i0, i1);
+        });
+    }
+    L.P.restrictTo(L.t.data(), C.r.data());
     cycle(l + 1);
-    // x += α S P_tent e.
-    const double alpha = mSettings.coarseWeight;
-    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) {
-            const int I = L.agg[i];
-            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
-            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
-            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
-        }
-    });
+    // x += α P e.
+    L.P.prolongAdd(C.x.data(), mSettings.coarseWeight, L.xp);
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "solver/linalg/bsr_kernels.h"
+#include "solver/linalg/prolongator.h"
 #include "solver/linalg/types.h"
 
 #include <Eigen/Cholesky>
@@ -18,6 +19,8 @@ struct Constraints;
 
 // How the filtered system is preconditioned inside conjugate gradient.
 enum class Preconditioner { BlockJacobi, Multigrid };
+// Which multigrid hierarchy (BlockMultigrid::Settings::smoothed, smoothedMinRows).
+enum class MultigridKind { Automatic, Plain, Smoothed };
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
 // column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
@@ -37,14 +40,25 @@ struct BsrMatrix {
     double multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single = nullptr) const;
 };
 
-// Plain (unsmoothed) aggregation AMG with a constraint-filtered tentative prolongator:
-//   P₀ = S P_tent,  P_tent(i, I) = I₃ when vertex i is in aggregate I  (translations: the
-// near-null space of the membrane stiffness), so the Galerkin operators
-//   A_{l+1} = P_lᵀ A_l P_l
-// are sums of the fine blocks and the coarse levels never see the constrained directions
-// (Tamstorf et al. 2015, §4). Aggregates (Vaněk, Mandel, Brezina 1996: a root plus its
-// neighbours, then the rest joined to a neighbouring aggregate) are chosen once per matrix
-// pattern, from the pattern alone; every later refresh only re-sums the values.
+// Smoothed-aggregation AMG (Vaněk, Mandel, Brezina 1996) for the filtered system
+//   Â = S A S + I − S                                        (Tamstorf, Jones, McCormick 2015)
+// with a near-null space B of rigid-body modes filtered by the constraints: for vertex i at x_i
+// in an aggregate with centroid c,
+//   B_i = S_i [ I₃ | −[x_i − c]× / ρ ]   (translations and rotations; ρ the aggregate's radius),
+// or the translations S_i alone when no positions are given (setPositions). Per level:
+//   P_tent = blockdiag(Q_J),  B_J = Q_J R_J  (orthonormalised on each aggregate J),
+//   P = (I − ω D⁻¹ Â) P_tent,  ω = (4/3) / ρ(D⁻¹Â)  (ρ by a few power steps),
+//   A_{l+1} = Pᵀ A_l P,   B_{l+1} = R,
+// so every level holds 6 unknowns per aggregate (two 3×3 block rows; one with translations
+// only). Rows of P lie in range(S_i) by construction (D_i⁻¹ keeps range(S_i)), so the coarse
+// levels never see the constrained directions, whatever the per-vertex filter (I, I − nnᵀ, 0).
+// Coarse unknowns no mode reaches (a fully pinned aggregate, a straight strand's twist) get an
+// identity diagonal and stay zero. Aggregates (a root plus its neighbours, then the rest joined
+// to a neighbouring aggregate) are chosen once per matrix pattern, from the pattern alone, on
+// the graph of nodes (a coarse node's two block rows aggregate together); every later refresh
+// recomputes the values (B, P, ω and the Galerkin products) from the current matrix and
+// positions only, so a resumed run builds the same hierarchy bit for bit. With `smoothed` off
+// and `rotations` off this is plain aggregation with translations (the benchmark's baseline).
 // The V-cycle uses damped block-Jacobi smoothing (ν sweeps before and the same after) or a
 // forward/backward multicolour block Gauss–Seidel pair, and a dense Cholesky on the coarsest
 // level, so the preconditioner is symmetric positive definite.
@@ -78,6 +92,15 @@ public:
         int rowBlock = 128;         // rows per block of the multicolour ordering
         bool multicolour = true;    // false: the natural row order, lexicographic Gauss–Seidel,
                                     // always sequential (the benchmark's baseline)
+        // Smoothed aggregation with the rigid-body near-null space from this many block rows
+        // of A up; below (and with `smoothed` off) plain aggregation with translations,
+        // P = S P_tent, bit for bit the path before issue 26: its set-up is cheap and on small
+        // meshes costs less than the iterations smoothing saves (bench/README.md, crossover).
+        bool smoothed = true;
+        int smoothedMinRows = 12000;
+        bool rotations = true;      // rotations in the near-null space (when positions are set)
+        double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
+        int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
     };
 
     // The settings new instances start with (process-wide, like setWideKernels: change them
@@ -85,11 +108,25 @@ public:
     static Settings& defaults();
 
     Settings& settings() { return mSettings; }
+    // Sets smoothed and smoothedMinRows for `kind` (Automatic: the defaults' threshold).
+    void setKind(MultigridKind kind) {
+        mSettings.smoothed = kind != MultigridKind::Plain;
+        mSettings.smoothedMinRows = kind == MultigridKind::Automatic ? defaults().smoothedMinRows : 0;
+    }
+
+    // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
+    // space; copied. Without them (or with another count) the near-null space is translations.
+    void setPositions(const double* x, int n) { mPositions.assign(x, x + 3 * static_cast<size_t>(n)); }
 
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
     // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
     // when a value is not finite.
-    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained);
+    // keepCoarse: only level 0 takes A's values; the coarse levels and prolongators stay those
+    // of the last full refresh (still an SPD preconditioner, for a matrix that changed little:
+    // Newton's iterates, GMRES's repeated solves with one matrix). Ignored when the pattern
+    // or the constrained rows changed.
+    bool refresh(const BlockMatrix& A, const Constraints& c, const std::vector<int>& constrained,
+                 bool keepCoarse = false);
     // 3n vectors from A's vertex order to level 0's colour order and back.
     void toLevelOrder(const double* natural, double* level) const;
     void fromLevelOrder(const double* level, double* natural) const;
@@ -110,31 +147,46 @@ public:
 
     int levelCount() const { return static_cast<int>(mLevels.size()); }
     int rows(int level) const { return mLevels[level].a.n; }
+    // Near-null modes per node of the coarse levels (6 with rotations, else 3).
+    int modes() const { return mModes; }
+    // The hierarchy in use is plain aggregation (Settings::smoothed, smoothedMinRows).
+    bool plain() const { return mPlain; }
+    // Bytes held by the hierarchy (matrices, prolongators, work vectors).
+    size_t bytes() const;
 
 private:
     struct Level {
         BsrMatrix a;
         std::vector<float> lowVal;     // a.val in single precision, read by the smoother
         std::vector<double> dinv;      // 9 per row: inverse diagonal block
-        std::vector<int> agg;          // aggregate (row of the next level) per row
-        std::vector<int> memberStart, members; // rows of each aggregate
-        std::vector<int> coarseSlot;   // slot of the next level's matrix per slot
-        std::vector<int> gatherStart,
-            gather;                    // per slot of the next level: the slots summed into it
         ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
         std::vector<int> visit;        // row of each natural index (the aggregation's order)
+        std::vector<double> nullB;     // near-null space: 3×modes per row, column-major
+        std::vector<uint8_t> dead;     // per scalar unknown: no mode reaches it (coarse levels)
+        std::vector<int> graphStart, graphCols; // node graph (colour-order nodes) to aggregate
+        Aggregates agg;                // nodes of this level → nodes of the next (agg.d: rows per node)
+        BlockProlongator P;            // to the next level
+        std::vector<double> Q;         // tentative prolongator: 3×modes per row
+        // Plain aggregation only (aggregatePlain): the aggregate of each row, the rows of each
+        // aggregate, the next level's slot of each slot and its inverse (the slots summed).
+        std::vector<int> plainAgg, plainStart, plainMembers, coarseSlot, gatherStart, gather;
         std::vector<double> r, x, t;   // 3n work vectors
         const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
         double* xp = nullptr;
     };
 
     void buildHierarchy(const BlockMatrix& A);
-    void aggregate(Level& fine, Level& coarse);
-    void coarsen(int l);
+    bool buildCoarse(int l); // false: coarsening stalls
+    void levelZeroNullSpace();
+    void coarsenValues(int l);
+    void aggregatePlain(Level& fine, Level& coarse);
+    void coarsenPlain(int l);
+    void finishLevel(int l);
     // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
     // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
+    void cyclePlainCoarse(int l, bool pull);
 
     Settings mSettings = defaults();
     std::vector<Level> mLevels;
@@ -144,6 +196,10 @@ private:
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;
+    std::vector<double> mPositions; // A's order, for the rotations
+    int mModes = 3;
+    bool mPlain = false;
+    bool mHaveCoarse = false; // the coarse levels hold values (keepCoarse may reuse them)
     Eigen::LLT<Eigen::MatrixXd> mCoarseLlt;
     Eigen::MatrixXd mCoarseDense;
     bool mCoarseOk = false;

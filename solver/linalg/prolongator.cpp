@@ -1,0 +1,366 @@
+// Smoothed aggregation in 3×3 blocks (see prolongator.h). References: Vaněk, Mandel, Brezina,
+// "Algebraic multigrid by smoothed aggregation for second and fourth order elliptic problems",
+// Computing 56 (1996); Tamstorf, Jones, McCormick, "Smoothed aggregation multigrid for cloth
+// simulation", SIGGRAPH Asia 2015.
+#include "solver/linalg/prolongator.h"
+
+#include "solver/linalg/multigrid.h"
+#include "solver/linalg/types.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+
+namespace gale::solver {
+
+namespace {
+
+using BlockMap = Eigen::Map<Mat3>;
+using ConstBlockMap = Eigen::Map<const Mat3>;
+
+int findSlot(const std::vector<int>& cols, int k0, int k1, int col) {
+    for (int k = k0; k < k1; ++k)
+        if (cols[k] == col) return k;
+    return -1; // not reached: the pattern holds every column written
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BlockProlongator
+
+void BlockProlongator::buildTranspose() {
+    tStart.assign(columns + 1, 0);
+    for (int c : cols) ++tStart[c + 1];
+    for (int J = 0; J < columns; ++J) tStart[J + 1] += tStart[J];
+    tRow.resize(cols.size());
+    tSlot.resize(cols.size());
+    std::vector<int> fill(tStart.begin(), tStart.end() - 1);
+    for (int r = 0; r < rows; ++r)
+        for (int k = start[r]; k < start[r + 1]; ++k) {
+            const int p = fill[cols[k]]++;
+            tRow[p] = r;
+            tSlot[p] = k;
+        }
+}
+
+void BlockProlongator::restrictTo(const double* x, double* y) const {
+    parallelChunks(static_cast<size_t>(columns), 256, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J) {
+            Vec3 s = Vec3::Zero();
+            for (int t = tStart[J]; t < tStart[J + 1]; ++t)
+                s.noalias() +=
+                    ConstBlockMap(val.data() + 9 * static_cast<size_t>(tSlot[t])).transpose() *
+                    Eigen::Map<const Vec3>(x + 3 * static_cast<size_t>(tRow[t]));
+            Eigen::Map<Vec3>(y + 3 * J) = s;
+        }
+    });
+}
+
+void BlockProlongator::prolongAdd(const double* e, double alpha, double* x) const {
+    parallelChunks(static_cast<size_t>(rows), 512, [&](size_t r0, size_t r1) {
+        for (size_t r = r0; r < r1; ++r) {
+            Vec3 s = Vec3::Zero();
+            for (int k = start[r]; k < start[r + 1]; ++k)
+                s.noalias() += ConstBlockMap(val.data() + 9 * static_cast<size_t>(k)) *
+                               Eigen::Map<const Vec3>(e + 3 * static_cast<size_t>(cols[k]));
+            Eigen::Map<Vec3>(x + 3 * r) += alpha * s;
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Aggregation
+
+int aggregateNodes(int n, const int* start, const int* cols, const std::vector<int>& visit,
+                   std::vector<int>& joined) {
+    std::vector<int> agg(n, -1), size;
+    // 1. Roots: a node whose neighbours are all unaggregated starts an aggregate with them.
+    for (int s = 0; s < n; ++s) {
+        const int i = visit[s];
+        if (agg[i] >= 0) continue;
+        bool free = true;
+        for (int k = start[i]; k < start[i + 1] && free; ++k)
+            if (agg[cols[k]] >= 0) free = false;
+        if (!free) continue;
+        for (int k = start[i]; k < start[i + 1]; ++k) agg[cols[k]] = static_cast<int>(size.size());
+        size.push_back(start[i + 1] - start[i]);
+    }
+    // 2. The rest join the smallest neighbouring aggregate (ties: the lower index), decided
+    // from the phase-1 labels only, so the order of the nodes does not matter.
+    joined = agg;
+    for (int i = 0; i < n; ++i) {
+        if (agg[i] >= 0) continue;
+        for (int k = start[i]; k < start[i + 1]; ++k) {
+            const int J = agg[cols[k]];
+            if (J >= 0 && (joined[i] < 0 || size[J] < size[joined[i]] ||
+                           (size[J] == size[joined[i]] && J < joined[i])))
+                joined[i] = J;
+        }
+    }
+    // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
+    int count = static_cast<int>(size.size());
+    for (int s = 0; s < n; ++s) {
+        const int i = visit[s];
+        if (joined[i] >= 0) continue;
+        joined[i] = count;
+        for (int k = start[i]; k < start[i + 1]; ++k)
+            if (joined[cols[k]] < 0) joined[cols[k]] = count;
+        ++count;
+    }
+    return count;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tentative prolongator
+
+namespace {
+
+// The tentative prolongator for M near-null modes (fixed-size eigen-decompositions).
+template <int M>
+void tentativeFixed(const Aggregates& g, const std::vector<double>& fineB, std::vector<double>& Q,
+                    std::vector<double>& coarseB, std::vector<uint8_t>& dead) {
+    using MatM = Eigen::Matrix<double, M, M>;
+    using Mat3M = Eigen::Matrix<double, 3, M>;
+    const int nc = static_cast<int>(g.memberStart.size()) - 1;
+    const int dc = M / 3, d = g.d;
+    const size_t stride = 3 * static_cast<size_t>(M); // values per block row of B and Q
+    Q.resize(fineB.size());
+    coarseB.assign(stride * dc * nc, 0.0);
+    dead.assign(static_cast<size_t>(M) * nc, 0);
+    parallelChunks(static_cast<size_t>(nc), 32, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J) {
+            MatM G = MatM::Zero();
+            for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                for (int q = 0; q < d; ++q) {
+                    const size_t r = static_cast<size_t>(g.members[t]) * d + q;
+                    const Eigen::Map<const Mat3M> B(fineB.data() + stride * r);
+                    G.noalias() += B.transpose() * B;
+                }
+            // G = Lᵀ-Cholesky with a column dropped when its pivot falls below 1e-8 of its
+            // diagonal (it lies in the span of the columns before it): R = Lᵀ, T = R⁻¹ on
+            // the kept columns, Q = B T (Gram–Schmidt in the fixed column order: a continuous
+            // function of B, so the rounding of either kernel set cannot turn the basis).
+            MatM L = MatM::Zero();
+            for (int k = 0; k < M; ++k) {
+                const double pivot = G(k, k) - L.row(k).head(k).squaredNorm();
+                if (!(G(k, k) > 0.0) || !(pivot > 1e-8 * G(k, k))) {
+                    dead[static_cast<size_t>(M) * J + k] = 1;
+                    continue;
+                }
+                L(k, k) = std::sqrt(pivot);
+                for (int i = k + 1; i < M; ++i)
+                    L(i, k) = (G(i, k) - L.row(i).head(k).dot(L.row(k).head(k))) / L(k, k);
+            }
+            const MatM R = L.transpose();
+            MatM T = MatM::Zero();
+            for (int k = 0; k < M; ++k) {
+                if (dead[static_cast<size_t>(M) * J + k]) continue;
+                Eigen::Matrix<double, M, 1> t = Eigen::Matrix<double, M, 1>::Zero();
+                t[k] = 1.0;
+                for (int j = 0; j < k; ++j) t -= R(j, k) * T.col(j);
+                T.col(k) = t / R(k, k);
+            }
+            for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
+                for (int q = 0; q < d; ++q) {
+                    const size_t r = static_cast<size_t>(g.members[t]) * d + q;
+                    const Eigen::Map<const Mat3M> B(fineB.data() + stride * r);
+                    Eigen::Map<Mat3M>(Q.data() + stride * r).noalias() = B * T;
+                }
+            for (int q = 0; q < dc; ++q)
+                Eigen::Map<Mat3M>(coarseB.data() + stride * (J * dc + q)) = R.middleRows(3 * q, 3);
+        }
+    });
+}
+
+} // namespace
+
+void tentativeProlongator(const Aggregates& g, int m, const std::vector<double>& fineB,
+                          std::vector<double>& Q, std::vector<double>& coarseB,
+                          std::vector<uint8_t>& dead) {
+    if (m == 6)
+        tentativeFixed<6>(g, fineB, Q, coarseB, dead);
+    else
+        tentativeFixed<3>(g, fineB, Q, coarseB, dead);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Smoothed prolongator
+
+void prolongatorPattern(const BsrMatrix& A, const Aggregates& g, int dc, bool smoothed,
+                        BlockProlongator& P) {
+    const int d = g.d;
+    P.rows = A.n;
+    P.columns = dc * static_cast<int>(g.memberStart.size() - 1);
+    P.start.assign(A.n + 1, 0);
+    P.cols.clear();
+    std::vector<int> row;
+    for (int r = 0; r < A.n; ++r) {
+        row.clear();
+        if (smoothed) {
+            for (int k = A.start[r]; k < A.start[r + 1]; ++k)
+                for (int q = 0; q < dc; ++q) row.push_back(g.nodeAgg[A.cols[k] / d] * dc + q);
+        } else {
+            for (int q = 0; q < dc; ++q) row.push_back(g.nodeAgg[r / d] * dc + q);
+        }
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        P.cols.insert(P.cols.end(), row.begin(), row.end());
+        P.start[r + 1] = static_cast<int>(P.cols.size());
+    }
+    P.val.assign(9 * P.cols.size(), 0.0);
+}
+
+void smoothProlongator(const BsrMatrix& A, const Aggregates& g, int dc, double omega,
+                       const std::vector<double>& Q, BlockProlongator& P) {
+    const int d = g.d;
+    const size_t stride = 9 * static_cast<size_t>(dc);
+    parallelChunks(static_cast<size_t>(A.n), 256, [&](size_t r0, size_t r1) {
+        for (size_t r = r0; r < r1; ++r) {
+            const int k0 = P.start[r], k1 = P.start[r + 1];
+            std::fill(P.val.begin() + 9 * static_cast<size_t>(k0),
+                      P.val.begin() + 9 * static_cast<size_t>(k1), 0.0);
+            if (omega == 0.0) {
+                const int U = g.nodeAgg[r / d];
+                for (int q = 0; q < dc; ++q) {
+                    const int slot = findSlot(P.cols, k0, k1, U * dc + q);
+                    BlockMap(P.val.data() + 9 * static_cast<size_t>(slot)) =
+                        ConstBlockMap(Q.data() + stride * r + 9 * q);
+                }
+                continue;
+            }
+            const Mat3 dinv = invertBlockOrScale(
+                ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(A.diag[r])));
+            for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
+                const int s = A.cols[k];
+                Mat3 M = -omega * dinv * ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(k));
+                if (s == static_cast<int>(r)) M += Mat3::Identity();
+                const int U = g.nodeAgg[s / d];
+                for (int q = 0; q < dc; ++q) {
+                    const int slot = findSlot(P.cols, k0, k1, U * dc + q);
+                    BlockMap(P.val.data() + 9 * static_cast<size_t>(slot)).noalias() +=
+                        M * ConstBlockMap(Q.data() + stride * s + 9 * q);
+                }
+            }
+        }
+    });
+}
+
+double spectralRadiusDinvA(const BsrMatrix& A, const double* dinv, int iterations) {
+    const size_t n3 = 3 * static_cast<size_t>(A.n);
+    if (n3 == 0) return 1.0;
+    std::vector<double> x(n3), y(n3);
+    for (size_t k = 0; k < n3; ++k) // a fixed, rough start: every mode present
+        x[k] = static_cast<double>((k * 2654435761u) % 1000u) / 1000.0 - 0.5;
+    for (int it = 0; it < iterations; ++it) {
+        A.multiply(x.data(), y.data());
+        parallelChunks(static_cast<size_t>(A.n), 1024, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i)
+                Eigen::Map<Vec3>(x.data() + 3 * i) =
+                    ConstBlockMap(dinv + 9 * i) * Eigen::Map<const Vec3>(y.data() + 3 * i);
+        });
+        const double norm = std::sqrt(deterministicDot(x.data(), x.data(), n3));
+        if (!(norm > 0.0) || !std::isfinite(norm)) return 1.0;
+        for (double& v : x) v /= norm;
+    }
+    A.multiply(x.data(), y.data());
+    const double num = deterministicDot(x.data(), y.data(), n3);
+    parallelChunks(static_cast<size_t>(A.n), 1024, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i)
+            Eigen::Map<Vec3>(y.data() + 3 * i) =
+                ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(A.diag[i])) *
+                Eigen::Map<const Vec3>(x.data() + 3 * i);
+    });
+    const double den = deterministicDot(x.data(), y.data(), n3);
+    return den > 0.0 && num > 0.0 ? num / den : 1.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Galerkin product
+
+void galerkinPattern(const BsrMatrix& A, const BlockProlongator& P, std::vector<int>& start,
+                     std::vector<int>& cols) {
+    const int nc = P.columns;
+    start.assign(nc + 1, 0);
+    cols.clear();
+    std::vector<int> mark(nc, -1), row;
+    for (int J = 0; J < nc; ++J) {
+        row.clear();
+        mark[J] = J;
+        row.push_back(J);
+        for (int t = P.tStart[J]; t < P.tStart[J + 1]; ++t) {
+            const int r = P.tRow[t];
+            for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
+                const int s = A.cols[k];
+                for (int m = P.start[s]; m < P.start[s + 1]; ++m)
+                    if (mark[P.cols[m]] != J) {
+                        mark[P.cols[m]] = J;
+                        row.push_back(P.cols[m]);
+                    }
+            }
+        }
+        std::sort(row.begin(), row.end());
+        cols.insert(cols.end(), row.begin(), row.end());
+        start[J + 1] = static_cast<int>(cols.size());
+    }
+}
+
+// Row J of C = Pᵀ (A P): Y_s = Σ_r P_rJᵀ A_rs over the fine rows r of column J of P (in
+// increasing order), then C_JK = Σ_s Y_s P_sK over the s in the order first reached. Scratch
+// per thread (its contents never outlive a row). Then C is made exactly symmetric (the two
+// triangles are summed in different orders): C_JK, C_KJ ← their mean.
+void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C) {
+    parallelChunks(static_cast<size_t>(C.n), 16, [&](size_t J0, size_t J1) {
+        thread_local std::vector<int> pos, cpos, touched;
+        thread_local std::vector<double> Y;
+        if (pos.size() < static_cast<size_t>(A.n)) pos.resize(A.n, -1);
+        if (cpos.size() < static_cast<size_t>(C.n)) cpos.resize(C.n, -1);
+        for (size_t J = J0; J < J1; ++J) {
+            for (int m = C.start[J]; m < C.start[J + 1]; ++m) {
+                cpos[C.cols[m]] = m;
+                std::fill_n(C.val.data() + 9 * static_cast<size_t>(m), 9, 0.0);
+            }
+            touched.clear();
+            Y.clear();
+            for (int t = P.tStart[J]; t < P.tStart[J + 1]; ++t) {
+                const int r = P.tRow[t];
+                const Mat3 Wt =
+                    ConstBlockMap(P.val.data() + 9 * static_cast<size_t>(P.tSlot[t])).transpose();
+                for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
+                    const int s = A.cols[k];
+                    if (pos[s] < 0) {
+                        pos[s] = static_cast<int>(touched.size());
+                        touched.push_back(s);
+                        Y.resize(Y.size() + 9, 0.0);
+                    }
+                    BlockMap(Y.data() + 9 * static_cast<size_t>(pos[s])).noalias() +=
+                        Wt * ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(k));
+                }
+            }
+            for (size_t idx = 0; idx < touched.size(); ++idx) {
+                const int s = touched[idx];
+                const ConstBlockMap Ys(Y.data() + 9 * idx);
+                for (int m = P.start[s]; m < P.start[s + 1]; ++m)
+                    BlockMap(C.val.data() + 9 * static_cast<size_t>(cpos[P.cols[m]])).noalias() +=
+                        Ys * ConstBlockMap(P.val.data() + 9 * static_cast<size_t>(m));
+                pos[s] = -1;
+            }
+            for (int m = C.start[J]; m < C.start[J + 1]; ++m) cpos[C.cols[m]] = -1;
+        }
+    });
+    // Symmetrise: each row writes its diagonal and its blocks right of the diagonal together
+    // with their mirrors (rows below): no two rows write the same slot.
+    parallelChunks(static_cast<size_t>(C.n), 256, [&](size_t J0, size_t J1) {
+        for (size_t J = J0; J < J1; ++J)
+            for (int m = C.diag[J]; m < C.start[J + 1]; ++m) {
+                BlockMap a(C.val.data() + 9 * static_cast<size_t>(m));
+                BlockMap b(C.val.data() + 9 * static_cast<size_t>(C.mirror[m]));
+                const Mat3 s = 0.5 * (a + b.transpose());
+                a = s;
+                b = s.transpose();
+            }
+    });
+}
+
+} // namespace gale::solver
