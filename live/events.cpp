@@ -36,6 +36,14 @@ bool EventHub::next(uint64_t after, int ms, Event& out) {
     return false;
 }
 
+std::vector<Event> EventHub::since(uint64_t after) const {
+    std::lock_guard<std::mutex> lock(mMutex);
+    std::vector<Event> out;
+    for (const Event& e : mEvents)
+        if (e.id > after) out.push_back(e);
+    return out;
+}
+
 void EventHub::close() {
     {
         std::lock_guard<std::mutex> lock(mMutex);

@@ -7,6 +7,7 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <vector>
 
 namespace gale::live {
 
@@ -28,6 +29,8 @@ public:
     // Waits up to `ms` for an event newer than `after` or for close(); fills `out` with the
     // oldest such event still held (the hub keeps the last 256). False on timeout or close.
     bool next(uint64_t after, int ms, Event& out);
+    // Every event newer than `after` still held, oldest first (no waiting).
+    std::vector<Event> since(uint64_t after) const;
     // Wakes every stream for good: next() returns false from now on.
     void close();
     bool closed() const;

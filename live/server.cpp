@@ -4,7 +4,7 @@
 // read, and only the scene's files (by literal edits) and the simulation folder are written.
 #include "live/server.h"
 
-#include "live/events.h"
+#include "live/event_streams.h"
 #include "live/json.h"
 #include "live/project.h"
 #include "live/sim_job.h"
@@ -13,10 +13,16 @@
 
 #include <httplib.h>
 
+#include <arpa/inet.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -105,6 +111,125 @@ bool intParam(const httplib::Request& req, const char* name, int def, int lo, in
     return true;
 }
 
+// A connection's socket as httplib's Stream, with a read buffer kept over its keep-alive
+// requests. Once an event stream has taken the socket over (take()), writes are swallowed:
+// httplib's reply to that request never reaches the wire, EventStreams writes instead.
+class SocketStream final : public httplib::Stream {
+public:
+    SocketStream(int fd, int readMs, int writeMs) : mFd(fd), mReadMs(readMs), mWriteMs(writeMs) {}
+    bool is_readable() const override { return mPos < mLen || ready(POLLIN, mReadMs); }
+    bool is_writable() const override { return mTaken || ready(POLLOUT, mWriteMs); }
+    ssize_t read(char* ptr, size_t size) override {
+        if (mPos == mLen) {
+            if (!ready(POLLIN, mReadMs)) return -1;
+            ssize_t n;
+            do n = ::recv(mFd, mBuf, sizeof mBuf, 0);
+            while (n < 0 && errno == EINTR);
+            if (n <= 0) return n;
+            mPos = 0;
+            mLen = static_cast<size_t>(n);
+        }
+        const size_t k = std::min(size, mLen - mPos);
+        std::memcpy(ptr, mBuf + mPos, k);
+        mPos += k;
+        return static_cast<ssize_t>(k);
+    }
+    ssize_t write(const char* ptr, size_t size) override {
+        if (mTaken) return static_cast<ssize_t>(size);
+        if (!ready(POLLOUT, mWriteMs)) return -1;
+        ssize_t n;
+        do n = ::send(mFd, ptr, size, MSG_NOSIGNAL);
+        while (n < 0 && errno == EINTR);
+        return n;
+    }
+    void get_remote_ip_and_port(std::string& ip, int& port) const override {
+        address(::getpeername, ip, port);
+    }
+    void get_local_ip_and_port(std::string& ip, int& port) const override {
+        address(::getsockname, ip, port);
+    }
+    socket_t socket() const override { return mFd; }
+    bool buffered() const { return mPos < mLen; }
+    void take() { mTaken = true; }
+    bool taken() const { return mTaken; }
+
+private:
+    bool ready(short what, int ms) const {
+        pollfd p{mFd, what, 0};
+        int r;
+        do r = ::poll(&p, 1, ms);
+        while (r < 0 && errno == EINTR);
+        return r > 0 && (p.revents & (what | POLLHUP | POLLERR));
+    }
+    template <typename Get>
+    void address(Get get, std::string& ip, int& port) const {
+        sockaddr_storage a{};
+        socklen_t len = sizeof a;
+        ip.clear();
+        port = 0;
+        if (get(mFd, reinterpret_cast<sockaddr*>(&a), &len) != 0) return;
+        char text[INET6_ADDRSTRLEN] = "";
+        if (a.ss_family == AF_INET) {
+            const auto* v4 = reinterpret_cast<const sockaddr_in*>(&a);
+            inet_ntop(AF_INET, &v4->sin_addr, text, sizeof text);
+            port = ntohs(v4->sin_port);
+        } else if (a.ss_family == AF_INET6) {
+            const auto* v6 = reinterpret_cast<const sockaddr_in6*>(&a);
+            inet_ntop(AF_INET6, &v6->sin6_addr, text, sizeof text);
+            port = ntohs(v6->sin6_port);
+        }
+        ip = text;
+    }
+
+    int mFd;
+    int mReadMs, mWriteMs;
+    char mBuf[4096];
+    size_t mPos = 0, mLen = 0;
+    bool mTaken = false;
+};
+
+// The connection being served on this worker thread (the /api/events handler takes it over).
+thread_local SocketStream* tConnection = nullptr;
+
+// cpp-httplib's server with its per-connection loop replaced (the same keep-alive rules) so
+// that an /api/events request can hand its socket to EventStreams and free the worker: with
+// cpp-httplib's own loop every open stream held one of the pool's threads.
+class HttpServer final : public httplib::Server {
+private:
+    bool process_and_close_socket(socket_t sock) override {
+        SocketStream strm(sock,
+                          static_cast<int>(read_timeout_sec_ * 1000 + read_timeout_usec_ / 1000),
+                          static_cast<int>(write_timeout_sec_ * 1000 + write_timeout_usec_ / 1000));
+        tConnection = &strm;
+        bool ok = false;
+        for (size_t left = keep_alive_max_count_; left > 0; --left) {
+            if (!strm.buffered() && !keepAlive(sock)) break;
+            bool closed = false;
+            ok = process_request(strm, left == 1, closed, nullptr);
+            if (!ok || closed || strm.taken()) break;
+        }
+        tConnection = nullptr;
+        if (!strm.taken()) {
+            ::shutdown(sock, SHUT_RDWR);
+            ::close(sock);
+        }
+        return ok;
+    }
+    // Waits up to the keep-alive timeout for the next request, giving up when the server stops.
+    bool keepAlive(int sock) const {
+        const auto end =
+            std::chrono::steady_clock::now() + std::chrono::seconds(keep_alive_timeout_sec_);
+        while (svr_sock_ != INVALID_SOCKET) {
+            pollfd p{sock, POLLIN, 0};
+            const int r = ::poll(&p, 1, 100);
+            if (r > 0) return true;
+            if (r < 0 && errno != EINTR) return false;
+            if (std::chrono::steady_clock::now() >= end) return false;
+        }
+        return false;
+    }
+};
+
 } // namespace
 
 class Server::Impl {
@@ -134,7 +259,7 @@ public:
             std::lock_guard<std::mutex> lock(mMutex);
             mProject.load();
         }
-        if (!mWatcher.start(error)) return false;
+        if (!mWatcher.start(error) || !mEvents.start(error)) return false;
         watchProjectFiles();
         routes();
         // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, with which a second
@@ -167,7 +292,7 @@ public:
         std::lock_guard<std::mutex> stopping(mStopMutex);
         if (mStopped) return;
         mStopped = true;
-        mEvents.close();
+        mEvents.stop();
         mSim.stop();
         if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
             std::error_code ec;
@@ -314,8 +439,13 @@ private:
                       asset(res, a->second.first, a->second.second);
                   });
         mHttp.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
-            std::lock_guard<std::mutex> lock(mMutex);
-            reply(res, stateJson(mProject, mTime));
+            json state;
+            {
+                std::lock_guard<std::mutex> lock(mMutex);
+                state = stateJson(mProject, mTime);
+            }
+            state["eventStreams"] = mEvents.count();
+            reply(res, state);
         });
         mHttp.Get("/api/scene", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
@@ -350,29 +480,20 @@ private:
         mHttp.Post("/api/simulate", [this](const httplib::Request& req, httplib::Response& res) {
             simulate(req, res);
         });
-        mHttp.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-            res.set_header("Cache-Control", "no-store");
-            auto last = std::make_shared<uint64_t>(mEvents.latest());
-            auto hello = std::make_shared<bool>(false);
-            res.set_chunked_content_provider(
-                "text/event-stream", [this, last, hello](size_t, httplib::DataSink& sink) {
-                    if (!*hello) {
-                        *hello = true;
-                        const std::string h = "retry: 1000\n: gale live\n\n";
-                        return sink.write(h.data(), h.size());
-                    }
-                    Event e;
-                    for (int waited = 0; waited < 15000; waited += 500) {
-                        if (mEvents.closed() || !sink.is_writable()) return false;
-                        if (mEvents.next(*last, 500, e)) {
-                            *last = e.id;
-                            const std::string text = eventText(e);
-                            return sink.write(text.data(), text.size());
-                        }
-                    }
-                    const std::string ping = ": ping\n\n";
-                    return sink.write(ping.data(), ping.size());
-                });
+        // The socket is handed to EventStreams (no worker is held while the stream is open);
+        // Last-Event-ID (an EventSource reconnecting) resumes after the last event it had.
+        mHttp.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
+            SocketStream* conn = tConnection;
+            if (!conn) return fail(res, 500, "no connection to stream events on");
+            uint64_t after = mEvents.latest();
+            const std::string last = req.get_header_value("Last-Event-ID");
+            if (!last.empty()) {
+                char* end = nullptr;
+                const unsigned long long id = std::strtoull(last.c_str(), &end, 10);
+                if (end == last.c_str() + last.size() && id < after) after = id;
+            }
+            conn->take();
+            mEvents.adopt(conn->socket(), after);
         });
     }
 
@@ -569,10 +690,10 @@ private:
     std::mutex mMutex; // the project and mTime
     Project mProject;
     double mTime = 0.0;
-    EventHub mEvents;
+    EventStreams mEvents;
     FileWatcher mWatcher;
     SimJob mSim;
-    httplib::Server mHttp;
+    HttpServer mHttp;
     std::thread mThread;
     int mPort = 0;
     std::string mTempDir;
