@@ -329,12 +329,13 @@ public:
 
 private:
     void watchProjectFiles() {
-        std::set<std::string> files;
+        std::set<std::string> files, patterns;
         {
             std::lock_guard<std::mutex> lock(mMutex);
             files.insert(mProject.files().begin(), mProject.files().end());
+            patterns.insert(mProject.patterns().begin(), mProject.patterns().end());
         }
-        mWatcher.watch(files);
+        mWatcher.watch(files, patterns);
     }
 
     // A reload after edits: the new files are watched; `field` when it compiled, else
@@ -450,6 +451,12 @@ private:
         mHttp.Get("/api/scene", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
             reply(res, sceneJson(mProject));
+        });
+        mHttp.Get("/api/colliders", [this](const httplib::Request& req, httplib::Response& res) {
+            double t = 0;
+            if (!numberParam(req, "t", 0.0, t)) return fail(res, 400, "t: a time in seconds");
+            std::lock_guard<std::mutex> lock(mMutex);
+            reply(res, collidersJson(mProject, t));
         });
         mHttp.Get("/api/file", [this](const httplib::Request& req, httplib::Response& res) {
             const std::string path =

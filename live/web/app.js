@@ -15,8 +15,10 @@ async function api(path, body) {
   return j;
 }
 
-const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null });
+const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null });
 const view = new View($('view'));
+live.screenBox = (name) => view.screenBox(name);
+live.setTime = (t) => setTime(t);
 const timeline = new Timeline($('timeline'), (t) => setTime(t));
 let state = null, scene = null, fieldData = null, currentFile = null;
 let time = 0, playing = false, simFrames = [], shownFrame = null;
@@ -124,6 +126,28 @@ async function refreshScene() {
   scene = await api('/api/scene');
   view.setBox(scene.box);
   view.setBodies(scene.rest, scene.colliders);
+  colliderShown = null;
+  showColliders(colliderWanted === null ? 0 : colliderWanted);
+}
+
+// The colliders at time t (the shown frame's time while a simulation's frame is shown): one
+// request in flight, the newest wish kept.
+let colliderWanted = null, colliderShown = null, colliderBusy = false;
+async function showColliders(t) {
+  colliderWanted = t;
+  if (!scene || !scene.colliders.length || colliderBusy || t === colliderShown) return;
+  colliderBusy = true;
+  try {
+    const c = await api('/api/colliders?t=' + t);
+    view.setColliderPoses(c.colliders);
+    colliderShown = t;
+    live.colliderTime = t;
+  } catch (e) {
+    live.errors.push(String(e.message || e));
+  } finally {
+    colliderBusy = false;
+    if (colliderWanted !== colliderShown) showColliders(colliderWanted);
+  }
 }
 
 function setTime(t) {
@@ -132,6 +156,7 @@ function setTime(t) {
   timeline.draw();
   $('timeText').textContent = `t = ${time.toFixed(3)} s · frame ${fmt(time * (state ? state.fps : 24), 1)}`;
   if (simFrames.length) showSimFrame(Math.round(time * state.fps));
+  else showColliders(time);
   refreshField();
 }
 
@@ -140,6 +165,7 @@ async function showSimFrame(f) {
   const n = have.length ? have[have.length - 1] : null;
   if (n === null || n === shownFrame) return;
   shownFrame = n;
+  showColliders(n / state.fps);
   try {
     const fr = await api('/api/frame?n=' + n);
     view.setSimFrame(fr.objects);
@@ -168,6 +194,10 @@ function tick(now) {
 
 function events() {
   const es = new EventSource('/api/events?token=' + encodeURIComponent(token));
+  // (The tests read when each event arrived: [type, ms since the page loaded].)
+  live.events = [];
+  for (const type of ['field', 'diagnostics', 'frame', 'sim']) es.addEventListener(type, () => live.events.push([type, performance.now()]));
+  es.addEventListener('error', () => live.events.push(['error', performance.now()]));
   es.addEventListener('field', async () => {
     await refreshState();
     await refreshScene();
