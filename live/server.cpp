@@ -10,6 +10,7 @@
 #include "live/sim_job.h"
 #include "live/watcher.h"
 #include "viz/overlays.h"
+#include "viz/strain.h"
 
 #include <httplib.h>
 
@@ -18,6 +19,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -239,10 +241,14 @@ public:
           mWatcher([this](const std::set<std::string>& files) { onFilesChanged(files); }, 15),
           mSim(
               [this](long f) {
-                  publish("frame", json{{"frame", f}});
+                  publish("frame", json{{"frame", f}, {"run", mRunId.load()}});
               },
               [this](int code, const std::string& log) {
-                  publish("sim", json{{"running", false}, {"exit", code}, {"log", log}});
+                  publish("sim", json{{"running", false},
+                                      {"exit", code},
+                                      {"log", log},
+                                      {"run", mRunId.load()},
+                                      {"on", mSimulateOn.load()}});
               }) {
         if (mOpt.token.empty()) mOpt.token = randomToken();
         if (mOpt.webDir.empty()) mOpt.webDir = GALE_LIVE_WEB_DIR;
@@ -364,6 +370,66 @@ private:
         }
         watchProjectFiles();
         publish(ok ? "field" : "diagnostics", event);
+        // Live re-simulation: while Simulate is on, an edit that compiles restarts the run from
+        // the first frame with the new scene (the old child killed by its pid).
+        if (ok && mSimulateOn) {
+            std::string error;
+            if (!startSimulation(true, error))
+                publish("sim", json{{"running", false}, {"exit", 1}, {"log", error}});
+        }
+    }
+
+    // Starts (or, `restart`, replaces) the background `gale sim` in a new folder. False with
+    // `error` (and the HTTP status in `status`) when it cannot.
+    bool startSimulation(bool restart, std::string& error, int* status = nullptr) {
+        std::lock_guard<std::mutex> simLock(mSimMutex);
+        auto refuse = [&](int code, const std::string& message) {
+            if (status) *status = code;
+            error = message;
+            return false;
+        };
+        if (mOpt.galeExecutable.empty())
+            return refuse(409, "simulation is not available in this server");
+        std::vector<SimObject> objects;
+        long first, last;
+        bool scene;
+        {
+            std::lock_guard<std::mutex> lock(mMutex);
+            objects = mProject.simObjects();
+            first = mProject.frameStart();
+            last = mProject.frameEnd();
+            scene = mProject.isScene();
+        }
+        if (!scene || objects.empty())
+            return refuse(
+                409, "nothing to simulate: give gale live a SCENE.toml with [[cloth]] or [[hair]]");
+        std::string dir = mOpt.simDir;
+        if (dir.empty()) {
+            if (mTempDir.empty()) {
+                char tmpl[] = "/tmp/gale-live-XXXXXX";
+                if (!mkdtemp(tmpl)) return refuse(500, "cannot create a folder for the simulation");
+                mTempDir = tmpl;
+            }
+            dir = mTempDir + "/sim" + std::to_string(mRuns + 1);
+        }
+        const std::string oldDir = mSim.outDir();
+        mSim.stop(true); // (its exit event carries the old run's id)
+        ++mRuns;
+        mRunId = mRuns;
+        if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
+            return refuse(500, error);
+        // A replaced run's folder is thrown away (the page keeps what it drew, greyed).
+        if (restart && mOpt.simDir.empty() && !oldDir.empty() && oldDir != dir) {
+            std::error_code ec;
+            fs::remove_all(oldDir, ec);
+        }
+        publish("sim", json{{"running", true},
+                            {"dir", dir},
+                            {"frames", {first, last}},
+                            {"run", mRunId.load()},
+                            {"restart", restart},
+                            {"on", true}});
+        return true;
     }
 
     bool authorised(const httplib::Request& req, httplib::Response& res) {
@@ -476,6 +542,8 @@ private:
         });
         mHttp.Get("/api/field",
                   [this](const httplib::Request& req, httplib::Response& res) { field(req, res); });
+        mHttp.Get("/api/run",
+                  [this](const httplib::Request&, httplib::Response& res) { run(res); });
         mHttp.Get("/api/frame",
                   [this](const httplib::Request& req, httplib::Response& res) { frame(req, res); });
         mHttp.Post("/api/param", [this](const httplib::Request& req, httplib::Response& res) {
@@ -558,6 +626,11 @@ private:
             return fail(res, 400, "n: a frame number");
         const std::string dir = mSim.outDir();
         if (dir.empty()) return fail(res, 404, "no simulation yet: POST /api/simulate");
+        std::vector<viz::GeometryOverlay> rest;
+        {
+            std::lock_guard<std::mutex> lock(mMutex);
+            rest = mProject.restGeometry();
+        }
         json objects = json::array();
         for (const SimObject& o : mSim.objects()) {
             viz::GeometryOverlay g;
@@ -565,9 +638,60 @@ private:
             if (!viz::loadFrameGeometry(simFramePath(dir, o.name, n, o.format), g, error))
                 return fail(res, 404, "frame " + std::to_string(n) + " is not written yet");
             g.label = o.name;
-            objects.push_back(geometryJson(g));
+            json j = geometryJson(g);
+            // Strain against the rest shape the solver starts from (viz/strain.h), per vertex.
+            for (const viz::GeometryOverlay& r : rest)
+                if (r.label == o.name) {
+                    json strain = json::array();
+                    for (double x : viz::vertexStrain(r, g))
+                        strain.push_back(std::round(x * 1e4) / 1e4);
+                    j["strain"] = strain;
+                }
+            objects.push_back(j);
         }
-        reply(res, json{{"frame", n}, {"objects", objects}});
+        reply(res, json{{"frame", n}, {"run", mRunId.load()}, {"objects", objects}});
+    }
+
+    // The simulation's run.json (written at most once a second while it runs, then at the end)
+    // summarised per frame for the timeline: contacts, halved and recovered substeps, the
+    // largest stretch against [solver] over_stretch, failures, and each object's events.
+    void run(httplib::Response& res) {
+        const std::string dir = mSim.outDir();
+        if (dir.empty()) return fail(res, 404, "no simulation yet: POST /api/simulate");
+        std::string text;
+        if (!readFile((fs::path(dir) / "run.json").string(), text, 64u << 20))
+            return reply(res, json{{"status", "starting"}, {"frames", json::array()}});
+        const json run = json::parse(text, nullptr, false);
+        if (run.is_discarded() || !run.is_object())
+            return reply(res, json{{"status", "starting"}, {"frames", json::array()}});
+        const double overStretch = run.value("/settings/solver/over_stretch"_json_pointer, 3.0);
+        json frames = json::array();
+        for (const json& f : run.value("frames", json::array())) {
+            long contacts = 0, halved = 0, recovered = 0;
+            double stretch = 0;
+            json events = json::array();
+            for (const json& o : f.value("objects", json::array())) {
+                contacts += o.value("contacts", 0L);
+                halved += o.value("rejected_substeps", 0L);
+                recovered += o.value("recovered_substeps", 0L);
+                stretch = std::max(stretch, o.value("max_stretch", 0.0));
+                for (const json& e : o.value("events", json::array()))
+                    if (e.is_string())
+                        events.push_back(o.value("name", std::string()) + ": " +
+                                         e.get<std::string>());
+            }
+            frames.push_back({{"frame", f.value("frame", 0L)},
+                              {"failed", f.value("failed", false)},
+                              {"contacts", contacts},
+                              {"halved", halved},
+                              {"recovered", recovered},
+                              {"maxStretch", stretch},
+                              {"overStretched", stretch >= overStretch},
+                              {"events", events}});
+        }
+        reply(res, json{{"status", run.value("status", std::string())},
+                        {"overStretch", overStretch},
+                        {"frames", frames}});
     }
 
     bool bodyJson(const httplib::Request& req, httplib::Response& res, json& out) {
@@ -653,44 +777,22 @@ private:
         if (!bodyJson(req, res, body)) return;
         const std::string action = body.value("action", std::string("start"));
         if (action == "stop") {
+            mSimulateOn = false;
+            std::lock_guard<std::mutex> simLock(mSimMutex);
             mSim.stop();
         } else if (action == "start") {
-            if (mOpt.galeExecutable.empty())
-                return fail(res, 409, "simulation is not available in this server");
-            std::vector<SimObject> objects;
-            long first, last;
-            bool scene;
-            {
-                std::lock_guard<std::mutex> lock(mMutex);
-                objects = mProject.simObjects();
-                first = mProject.frameStart();
-                last = mProject.frameEnd();
-                scene = mProject.isScene();
-            }
-            if (!scene || objects.empty())
-                return fail(
-                    res, 409,
-                    "nothing to simulate: give gale live a SCENE.toml with [[cloth]] or [[hair]]");
-            std::string dir = mOpt.simDir;
-            if (dir.empty()) {
-                if (mTempDir.empty()) {
-                    char tmpl[] = "/tmp/gale-live-XXXXXX";
-                    if (!mkdtemp(tmpl))
-                        return fail(res, 500, "cannot create a folder for the simulation");
-                    mTempDir = tmpl;
-                }
-                dir = mTempDir + "/sim" + std::to_string(++mRuns);
-            }
             std::string error;
-            if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
-                return fail(res, 500, error);
-            publish("sim", json{{"running", true}, {"dir", dir}, {"frames", {first, last}}});
+            int status = 500;
+            if (!startSimulation(false, error, &status)) return fail(res, status, error);
+            mSimulateOn = true;
         } else {
             return fail(res, 400, "action: start or stop");
         }
-        reply(
-            res,
-            json{{"running", mSim.running()}, {"dir", mSim.outDir()}, {"last", mSim.lastFrame()}});
+        reply(res, json{{"running", mSim.running()},
+                        {"dir", mSim.outDir()},
+                        {"last", mSim.lastFrame()},
+                        {"run", mRunId.load()},
+                        {"on", mSimulateOn.load()}});
     }
 
     ServerOptions mOpt;
@@ -705,6 +807,9 @@ private:
     int mPort = 0;
     std::string mTempDir;
     int mRuns = 0;
+    std::mutex mSimMutex;                 // starting and stopping the simulation
+    std::atomic<int> mRunId{0};           // the current run, in its events
+    std::atomic<bool> mSimulateOn{false}; // Simulate pressed and not stopped: edits re-simulate
     std::mutex mStopMutex, mWaitMutex;
     std::condition_variable mWaitCv;
     bool mStopped = false, mDone = false;

@@ -13,6 +13,18 @@ export function colourAt(map, s) {
   return [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])];
 }
 
+// The strain colour map of viz/strain.h (strainColour), the same constants: `base` at 0,
+// yellow then red towards +top, teal towards −top, clamped beyond.
+export const STRAIN_TOP = 0.25;
+export function strainColour(strain, base, top = STRAIN_TOP) {
+  const s = Number.isFinite(strain) && top > 0 ? Math.min(1, Math.max(-1, strain / top)) : 0;
+  const mix = (a, b, w) => [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])];
+  const yellow = [0.98, 0.82, 0.22], red = [0.86, 0.12, 0.1], teal = [0.2, 0.82, 0.72];
+  if (s < 0) return mix(base, teal, -s);
+  return s < 0.5 ? mix(base, yellow, 2 * s) : mix(yellow, red, 2 * s - 1);
+}
+export const CLOTH_BASE = [0.42, 0.6, 0.86];
+
 export class View {
   constructor(canvas) {
     this.canvas = canvas;
@@ -293,8 +305,9 @@ export class View {
   // The screen rectangle (canvas pixels: x0, y0, x1, y1) of a collider's current bounds.
   screenBox(name) {
     const entry = (this.colliders || []).find((c) => c.name === name);
-    if (!entry || !entry.object) return null;
-    const box = new THREE.Box3().setFromObject(entry.object);
+    const object = entry && entry.object ? entry.object : this.groups.sim.getObjectByName(name);
+    if (!object) return null;
+    const box = new THREE.Box3().setFromObject(object);
     const w = this.canvas.width, h = this.canvas.height;
     let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
     for (let k = 0; k < 8; ++k) {
@@ -305,10 +318,24 @@ export class View {
     return [Math.max(0, Math.floor(x0)), Math.max(0, Math.floor(y0)), Math.min(w, Math.ceil(x1)), Math.min(h, Math.ceil(y1))];
   }
 
-  // Simulated frame geometry (replaces the rest meshes while shown).
-  setSimFrame(objects) {
+  // Simulated frame geometry (replaces the rest meshes while shown): coloured by strain (per
+  // vertex, from /api/frame) when `strain` is on; grey when `stale` (a run an edit replaced).
+  setSimFrame(objects, { strain = this.strainOn, stale = false } = {}) {
     this.clear('sim');
-    for (const o of objects) this.geometry(this.groups.sim, o, 0x8fc0ff);
+    this.simObjects = objects;
+    this.strainOn = strain;
+    for (const o of objects) {
+      const mesh = this.geometry(this.groups.sim, o, stale ? 0x808080 : 0x8fc0ff);
+      if (mesh) mesh.name = o.label;
+      if (mesh && strain && !stale && o.strain && o.strain.length * 3 === o.points.length) {
+        const col = new Float32Array(o.points.length);
+        o.strain.forEach((x, i) => col.set(strainColour(x, CLOTH_BASE), 3 * i));
+        mesh.geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
+        mesh.material.vertexColors = true;
+        mesh.material.color.set(0xffffff);
+        mesh.material.needsUpdate = true;
+      }
+    }
     this.groups.rest.visible = objects.length === 0 && this.groups.bodies.visible;
     this.render();
   }
