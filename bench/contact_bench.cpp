@@ -6,10 +6,10 @@
 // the cost per frame).
 // Usage: gale_bench_contact [steps=24]
 #include "geometry/geometry.h"
-#include "solver/cloth.h"
-#include "solver/collider.h"
-#include "solver/moving_collider.h"
-#include "solver/world.h"
+#include "solver/bodies/cloth.h"
+#include "solver/collider/collider.h"
+#include "solver/collider/moving_collider.h"
+#include "solver/world/world.h"
 
 #include <chrono>
 #include <cmath>

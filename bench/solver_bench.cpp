@@ -5,12 +5,12 @@
 //   [--size N] [--solver NAME] [--threads T]  (DIR gets CSV tables and SVG plots; --only runs
 //   one section; --size N and --solver NAME keep only those rows of the scaling table, --size N
 //   and --threads T only the multicolour T-thread run of the threads table, e.g. to profile one)
-#include "solver/bsr_kernels.h"
-#include "solver/cloth.h"
-#include "solver/linear.h"
-#include "solver/multigrid.h"
-#include "solver/types.h"
-#include "solver/world.h"
+#include "solver/linalg/bsr_kernels.h"
+#include "solver/bodies/cloth.h"
+#include "solver/linalg/linear.h"
+#include "solver/linalg/multigrid.h"
+#include "solver/linalg/types.h"
+#include "solver/world/world.h"
 
 #include <chrono>
 #include <cmath>

@@ -79,7 +79,7 @@ struct BuiltinsOptions {
     bool markdown = false; // the reference page docs/builtins.md is this output
 };
 
-// `gale sample` (cli/sample_command.cpp).
+// `gale sample` (cli/commands/sample_command.cpp).
 struct SampleOptions {
     SourceOptions source;   // FILE.se | -e EXPR | SCENE.toml, --set
     std::string bounds;     // x0,y0,z0,x1,y1,z1
@@ -94,7 +94,7 @@ struct SampleOptions {
     bool resume = false;    // --frames: skip frames whose file is already on disk
 };
 
-// `gale viz` (cli/viz_command.cpp).
+// `gale viz` (cli/commands/viz_command.cpp).
 struct VizOptions {
     SourceOptions source;
     std::string plane = "z=0";       // x=C | y=C | z=C
@@ -107,7 +107,7 @@ struct VizOptions {
     double speedMax = 0.0;           // colour scale top in m/s (0: from the slice)
     double arrowSpacing = 0.0;       // pixels between arrows (0: about 22 across)
     int threads = 0;
-    // Preview renders (cli/preview.cpp): frames of a simulation, contact sheets of wedges.
+    // Preview renders (cli/commands/preview.cpp): frames of a simulation, contact sheets of wedges.
     std::string frames;              // A:B (per-frame pictures; OUT has '#'), or a list for sheets
     std::string sim;                 // the gale sim output folder (default "sim")
     std::string contactSheet;        // a gale wedge output folder
@@ -131,7 +131,7 @@ Command addBuiltinsCommand(CLI::App& app);
 Command addSampleCommand(CLI::App& app);
 Command addVizCommand(CLI::App& app);
 
-// `gale sim SCENE.toml`: cloth and hair driven by the scene's wind (cli/sim_command.cpp).
+// `gale sim SCENE.toml`: cloth and hair driven by the scene's wind (cli/commands/sim_command.cpp).
 struct SimOptions {
     std::string scene;
     std::string output = "sim";    // OUTDIR
@@ -146,7 +146,7 @@ struct SimOptions {
 int runSim(const SimOptions& options);
 Command addSimCommand(CLI::App& app);
 
-// `gale wedge SCENE.toml --vary KEY=V1,V2,... -o OUTDIR` (cli/wedge_command.cpp).
+// `gale wedge SCENE.toml --vary KEY=V1,V2,... -o OUTDIR` (cli/wedge/wedge_command.cpp).
 struct WedgeOptions {
     std::string scene;
     std::vector<std::string> vary; // KEY=V1,V2,...
@@ -167,7 +167,7 @@ int runWedge(const WedgeOptions& options);
 Command addWedgeCommand(CLI::App& app);
 
 // `gale live SCENE.toml | FILE.se`: the field in a browser, updated as files change
-// (cli/live_command.cpp; the server is live/).
+// (cli/commands/live_command.cpp; the server is live/).
 Command addLiveCommand(CLI::App& app);
 
 } // namespace gale::cli

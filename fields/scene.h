@@ -1,6 +1,7 @@
 // A scene's wind description: settings, the windicator and gust rigs, and the [[field]]
 // entries, as the scene loader (scene/load.h) reads them from TOML. The bodies' sections
-// ([[cloth]], [[hair]], [[collider]], [solver]) are described in solver/scene.h.
+// ([[cloth]], [[hair]], [[collider]], [solver]) are described in scene/sim_scene.h, and
+// errors in the file are scene::SceneError (scene/error.h).
 #pragma once
 
 #include "fields/keyframes.h"
@@ -11,20 +12,6 @@
 #include <vector>
 
 namespace gale::fields {
-
-// An error in a scene file, at file:line:col (1-based; 0 when unknown).
-struct SceneError {
-    std::string file;
-    int line = 0;
-    int col = 0;
-    std::string message; // what is wrong and what to do
-    std::vector<std::string> notes; // extra lines ("did you mean", the declared parameters)
-    std::string sourceLine;         // the offending line of the file, when known
-    bool io = false;                // a file could not be read (the CLI exits 3, not 1)
-    // "file:line:col: error: message" (without :line:col when line is 0), then the source line
-    // with a caret under the column, then "note: ..." lines.
-    std::string render() const;
-};
 
 struct SceneSettings {
     double fps = 24.0;

@@ -3,8 +3,8 @@
 // temp file); the rest is the file. A point set read must be consistent and survive a PLY
 // round trip with the same shape; a mesh's triangles must index its vertices.
 #include "io/pointset.h"
-#include "solver/hair.h"
-#include "solver/mesh.h"
+#include "solver/bodies/hair.h"
+#include "solver/mesh/mesh.h"
 
 #include <unistd.h>
 

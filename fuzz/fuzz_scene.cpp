@@ -4,7 +4,7 @@
 #include "fields/expression_field.h"
 #include "fields/scene.h"
 #include "scene/load.h"
-#include "solver/scene.h"
+#include "scene/sim_scene.h"
 
 #include <unistd.h>
 
@@ -52,18 +52,18 @@ const std::string& workDir() {
 // path such as /dev/zero cannot stall the run); only the files written above exist there.
 bool inside(const std::string& path) { return path.empty() || path.rfind(workDir() + "/", 0) == 0; }
 
-bool smallAndLocal(const solver::SimScene& s) {
+bool smallAndLocal(const scene::SimScene& s) {
     for (const fields::FieldEntry& f : s.wind.fields) {
         if (!inside(f.exprPath)) return false;
         // FFT turbulence builds grids up to 512^3: too big for a fuzzing run.
         if (f.source.find("fftturb") != std::string::npos || f.mask.find("fftturb") != std::string::npos)
             return false;
     }
-    for (const solver::ClothSpec& c : s.cloths)
+    for (const scene::ClothSpec& c : s.cloths)
         if (!inside(c.meshPath) || !inside(c.lift.exprPath) || !inside(c.drag.exprPath) ||
             static_cast<long long>(c.gridRes[0]) * c.gridRes[1] > 4096)
             return false;
-    for (const solver::HairSpec& h : s.hairs)
+    for (const scene::HairSpec& h : s.hairs)
         if (!inside(h.strandsPath) || !inside(h.dragNormal.exprPath) || !inside(h.dragTangent.exprPath) ||
             static_cast<long long>(h.gridCount[0]) * h.gridCount[1] * (h.segments + 1) > 4096)
             return false;
@@ -79,11 +79,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::ofstream out(path, std::ios::binary | std::ios::trunc);
         out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
     }
-    solver::SimScene scene;
-    std::vector<fields::SceneError> errors;
+    scene::SimScene scene;
+    std::vector<scene::SceneError> errors;
     ++gStats.inputs;
     const bool loaded = gale::scene::loadSimScene(path, scene, errors);
-    for (const fields::SceneError& e : errors) (void)e.render();
+    for (const scene::SceneError& e : errors) (void)e.render();
     if (loaded && !errors.empty()) __builtin_trap(); // success must not come with errors
     if (!loaded) {
         if (errors.empty()) __builtin_trap(); // a failure must say why
@@ -107,9 +107,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     std::vector<std::unique_ptr<solver::Body>> bodies;
     std::vector<std::string> warnings;
-    std::vector<fields::SceneError> buildErrors;
-    if (!solver::buildBodies(scene, bodies, buildErrors, warnings) && buildErrors.empty()) __builtin_trap();
+    std::vector<scene::SceneError> buildErrors;
+    if (!scene::buildBodies(scene, bodies, buildErrors, warnings) && buildErrors.empty()) __builtin_trap();
     if (!bodies.empty()) ++gStats.bodies;
-    (void)solver::worldSettings(scene, 1);
+    (void)scene::worldSettings(scene, 1);
     return 0;
 }

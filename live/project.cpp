@@ -6,15 +6,14 @@
 #include "fields/expression_field.h"
 #include "io/atomic_file.h"
 #include "lang/diagnostics.h"
+#include "scene/document.h"
 #include "scene/load.h"
-#include "solver/body.h"
-#include "solver/collider.h"
-#include "solver/mesh_sequence.h"
-#include "solver/moving_collider.h"
-#include "solver/scene.h"
+#include "scene/sim_scene.h"
+#include "solver/bodies/body.h"
+#include "solver/collider/collider.h"
+#include "solver/mesh/mesh_sequence.h"
+#include "solver/collider/moving_collider.h"
 #include "viz/overlays.h"
-
-#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -53,17 +52,6 @@ bool readText(const std::string& path, std::string& out, std::string& error) {
     s << in.rdbuf();
     out = s.str();
     return true;
-}
-
-// Byte offset of 1-based (line, col) in `text`.
-size_t offsetOf(const std::string& text, uint32_t line, uint32_t col) {
-    size_t pos = 0;
-    for (uint32_t l = 1; l < line && pos != std::string::npos; ++l) {
-        pos = text.find('\n', pos);
-        if (pos != std::string::npos) ++pos;
-    }
-    if (pos == std::string::npos) return text.size();
-    return std::min(text.size(), pos + col - 1);
 }
 
 // The rendered diagnostics of buildSceneField (`file:line:col: error: message`, then source and
@@ -249,41 +237,26 @@ void Project::loadExpressionFile() {
 }
 
 void Project::loadSceneFile() {
-    solver::SimScene sim;
-    std::vector<fields::SceneError> errors;
+    gale::scene::SimScene sim;
+    std::vector<gale::scene::SceneError> errors;
     std::string sceneText, error;
     if (!readText(mInput, sceneText, error)) {
         mDiagnostics.push_back({mInput, 0, 0, "error", error, mInput + ": error: " + error});
         return;
     }
     // Every string in the scene naming a file beside it is watched (expressions, meshes,
-    // strands, collider meshes), and the field overrides' literals are located.
-    std::optional<toml::table> doc;
-    try {
-        doc = toml::parse(sceneText, mInput);
-    } catch (const toml::parse_error&) {
-        // loadSimScene reports it at file:line:col
-    }
+    // strands, collider meshes), and the field overrides' literals are located. A syntax error
+    // is loadSimScene's to report at file:line:col.
+    gale::scene::SceneDocument doc;
+    std::vector<gale::scene::SceneError> syntax;
+    const bool parsed = doc.parse(mInput, sceneText, syntax);
     const std::string baseDir = fs::path(mInput).parent_path().string();
-    if (doc) {
-        std::function<void(const toml::node&)> walk = [&](const toml::node& n) {
-            if (const auto* s = n.as_string()) {
-                const fs::path p = fs::path(baseDir) / s->get();
-                std::error_code ec;
-                if (s->get().size() < 1000 && fs::is_regular_file(p, ec))
-                    addFile(p.string());
-                else if (s->get().size() < 1000)
-                    addPattern(p.string());
-            } else if (const auto* t = n.as_table()) {
-                for (const auto& kv : *t) walk(kv.second);
-            } else if (const auto* a = n.as_array()) {
-                for (const auto& e : *a) walk(e);
-            }
-        };
-        walk(*doc);
+    if (parsed) {
+        for (const std::string& f : doc.namedFiles()) addFile(f);
+        for (const std::string& p : doc.otherPaths()) addPattern(p); // (not there yet: watched for)
     }
     const bool loaded = gale::scene::loadSimScene(mInput, sim, errors);
-    for (const fields::SceneError& e : errors) {
+    for (const gale::scene::SceneError& e : errors) {
         std::string text = e.render();
         while (!text.empty() && text.back() == '\n') text.pop_back();
         mDiagnostics.push_back({e.file, e.line, e.col, "error", e.message, text});
@@ -294,11 +267,10 @@ void Project::loadSceneFile() {
     mFrameStart = scene->settings.frameStart;
     mFrameEnd = scene->settings.frameEnd;
     mScene = scene;
-    for (const solver::ClothSpec& c : sim.cloths) mObjects.push_back({c.name, c.output});
-    for (const solver::HairSpec& h : sim.hairs) mObjects.push_back({h.name, h.output});
+    for (const gale::scene::ClothSpec& c : sim.cloths) mObjects.push_back({c.name, c.output});
+    for (const gale::scene::HairSpec& h : sim.hairs) mObjects.push_back({h.name, h.output});
 
     // Parameters of each expression file, and the scene's overrides of them.
-    const toml::array* fieldTables = doc ? (*doc)["field"].as_array() : nullptr;
     for (size_t i = 0; i < scene->fields.size(); ++i) {
         const fields::FieldEntry& entry = scene->fields[i];
         if (entry.exprPath.empty()) continue;
@@ -319,19 +291,14 @@ void Project::loadSceneFile() {
                 lp.literal.value = over->second.at(0.0);
                 lp.editable = false;
                 // A constant number (or array of numbers) in `params = { name = ... }`.
-                const toml::table* ft =
-                    fieldTables && i < fieldTables->size() ? (*fieldTables)[i].as_table() : nullptr;
-                const toml::table* pt = ft ? (*ft)["params"].as_table() : nullptr;
-                const toml::node* v = pt ? pt->get(p.name) : nullptr;
-                if (v && !over->second.isKeyed() && (v->is_number() || v->is_array())) {
-                    const auto& src = v->source();
+                const std::optional<gale::scene::SourceSpan> span =
+                    parsed && !over->second.isKeyed() ? doc.fieldParamLiteral(i, p.name) : std::nullopt;
+                if (span) {
                     lp.file = mInput;
-                    lp.literal.line = static_cast<int>(src.begin.line);
-                    lp.literal.col = static_cast<int>(src.begin.column);
-                    lp.literal.begin = static_cast<uint32_t>(
-                        offsetOf(sceneText, src.begin.line, src.begin.column));
-                    lp.literal.end =
-                        static_cast<uint32_t>(offsetOf(sceneText, src.end.line, src.end.column));
+                    lp.literal.line = span->line;
+                    lp.literal.col = span->col;
+                    lp.literal.begin = static_cast<uint32_t>(span->begin);
+                    lp.literal.end = static_cast<uint32_t>(span->end);
                     lp.editable = lp.literal.end > lp.literal.begin;
                     lp.text = sceneText.substr(lp.literal.begin, lp.literal.end - lp.literal.begin);
                 }
@@ -349,12 +316,12 @@ void Project::loadSceneFile() {
 
     // Rest meshes of the cloth and hair, and the colliders at t = 0.
     std::vector<std::unique_ptr<solver::Body>> bodies;
-    std::vector<fields::SceneError> bodyErrors;
+    std::vector<gale::scene::SceneError> bodyErrors;
     std::vector<std::string> warnings;
-    if (solver::buildBodies(sim, bodies, bodyErrors, warnings, mAllowPaths)) {
+    if (gale::scene::buildBodies(sim, bodies, bodyErrors, warnings, mAllowPaths)) {
         for (size_t b = 0; b < bodies.size(); ++b) {
             viz::GeometryOverlay g;
-            std::istringstream obj(solver::bodyObjText(*bodies[b]));
+            std::istringstream obj(gale::scene::bodyObjText(*bodies[b]));
             viz::parseObjGeometry(obj, g);
             g.label = b < sim.cloths.size() ? sim.cloths[b].name
                       : b - sim.cloths.size() < sim.hairs.size()
@@ -363,24 +330,21 @@ void Project::loadSceneFile() {
             mRest.push_back(std::move(g));
         }
     } else {
-        for (const fields::SceneError& e : bodyErrors) {
+        for (const gale::scene::SceneError& e : bodyErrors) {
             std::string text = e.render();
             while (!text.empty() && text.back() == '\n') text.pop_back();
             mDiagnostics.push_back({e.file, e.line, e.col, "error", e.message, text});
         }
     }
-    const toml::array* colliderTables = doc ? (*doc)["collider"].as_array() : nullptr;
     mSimColliders = sim.colliders;
     for (size_t i = 0; i < sim.colliders.size(); ++i) {
         const solver::Collider& c = sim.colliders[i];
         ColliderShape s = colliderAt(c, 0.0);
-        if (c.shape == solver::ColliderShape::Mesh && !c.moving && colliderTables &&
-            i < colliderTables->size())
-            if (const toml::table* t = (*colliderTables)[i].as_table())
-                if (auto mesh = (*t)["mesh"].value<std::string>()) {
-                    std::string err;
-                    viz::loadFrameGeometry((fs::path(baseDir) / *mesh).string(), s.mesh, err);
-                }
+        const std::string mesh = parsed ? doc.colliderMesh(i) : std::string();
+        if (c.shape == solver::ColliderShape::Mesh && !c.moving && !mesh.empty()) {
+            std::string err;
+            viz::loadFrameGeometry((fs::path(baseDir) / mesh).string(), s.mesh, err);
+        }
         mColliders.push_back(std::move(s));
     }
 }

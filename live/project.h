@@ -8,7 +8,7 @@
 #include "fields/scene.h"
 #include "live/literals.h"
 #include "live/sim_job.h"
-#include "solver/collider.h"
+#include "solver/collider/collider.h"
 #include "viz/picture.h"
 #include "viz/volume_marks.h"
 

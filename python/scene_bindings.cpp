@@ -127,12 +127,12 @@ class Scene {
 public:
     Scene(std::string path, const py::object& sets, std::vector<std::string> allowPaths)
         : mPath(std::move(path)), mSets(setList(sets)), mAllow(std::move(allowPaths)) {
-        solver::SimScene sim;
-        std::vector<fields::SceneError> errors;
+        scene::SimScene sim;
+        std::vector<scene::SceneError> errors;
         if (!gale::scene::loadSimScene(mPath, sim, errors, mSets)) {
             run::RunError e;
             e.kind = run::RunError::Input;
-            for (const fields::SceneError& s : errors) {
+            for (const scene::SceneError& s : errors) {
                 e.rendered += s.render() + '\n';
                 if (s.io) e.kind = run::RunError::Io;
             }

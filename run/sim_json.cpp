@@ -47,7 +47,7 @@ std::string stepJson(const solver::StepOptions& s) {
 
 } // namespace
 
-std::string settingsJson(const solver::SimScene& sc,
+std::string settingsJson(const scene::SimScene& sc,
                          const std::vector<std::unique_ptr<Body>>& bodies, int first, int last,
                          int threads) {
     const fields::SceneSettings& s = sc.wind.settings;
@@ -65,7 +65,7 @@ std::string settingsJson(const solver::SimScene& sc,
         o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
     o << "], \"objects\": [";
     size_t bi = 0;
-    for (const solver::ClothSpec& c : sc.cloths) {
+    for (const scene::ClothSpec& c : sc.cloths) {
         const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
         const solver::ClothMaterial& m = c.material;
         o << (bi > 1 ? ", " : "") << "{\"name\": " << jsonString(c.name)
@@ -90,7 +90,7 @@ std::string settingsJson(const solver::SimScene& sc,
           << ", \"thickness\": " << num(c.collision.thickness) << ", \"output\": \"" << c.output
           << "\"}";
     }
-    for (const solver::HairSpec& h : sc.hairs) {
+    for (const scene::HairSpec& h : sc.hairs) {
         const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
         const solver::HairMaterial& m = h.material;
         o << (bi > 1 ? ", " : "") << "{\"name\": " << jsonString(h.name)

@@ -3,8 +3,8 @@
 // iterations, residuals, speeds, energies and events.
 #pragma once
 
-#include "solver/scene.h"
-#include "solver/world.h"
+#include "scene/sim_scene.h"
+#include "solver/world/world.h"
 
 #include <memory>
 #include <string>
@@ -14,7 +14,7 @@ namespace gale::run {
 
 // The settings as resolved (after --set) for frames first..last, run.json's "settings" (and
 // what --resume compares to continue only the same run).
-std::string settingsJson(const solver::SimScene& scene,
+std::string settingsJson(const scene::SimScene& scene,
                          const std::vector<std::unique_ptr<solver::Body>>& bodies, int first,
                          int last, int threads);
 

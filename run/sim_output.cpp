@@ -189,9 +189,9 @@ RunError SimOutput::writeObjects(int frame, double time) {
         const std::string path = frameFileName(mOptions.dir, b.name(), frame, format);
         if (format == "ply") {
             if (io::IoError e =
-                    io::writePointsFile(path, solver::bodyPointSet(b), io::PointFormat::Ply))
+                    io::writePointsFile(path, scene::bodyPointSet(b), io::PointFormat::Ply))
                 return ioError(e.render());
-        } else if (RunError e = writeBytes(path, solver::bodyObjText(b))) {
+        } else if (RunError e = writeBytes(path, scene::bodyObjText(b))) {
             return e;
         }
     }

@@ -10,16 +10,16 @@ namespace gale::run {
 
 RunError SimRun::load(const SimSetup& s, std::string& report) {
     RunError err;
-    std::vector<fields::SceneError> errors;
-    auto sceneErrors = [&](const std::vector<fields::SceneError>& es) {
+    std::vector<scene::SceneError> errors;
+    auto sceneErrors = [&](const std::vector<scene::SceneError>& es) {
         err.kind = RunError::Input;
-        for (const fields::SceneError& e : es) {
+        for (const scene::SceneError& e : es) {
             err.rendered += e.render() + '\n';
             if (e.io) err.kind = RunError::Io;
         }
         return err;
     };
-    mScene = solver::SimScene();
+    mScene = scene::SimScene();
     if (!gale::scene::loadSimScene(s.scene, mScene, errors, s.sets)) return sceneErrors(errors);
     std::string fieldReport;
     fields::FieldPtr wind = fields::buildSceneField(mScene.wind, runtime::Precision::Float,
@@ -31,7 +31,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     }
     std::vector<std::unique_ptr<solver::Body>> bodies;
     std::vector<std::string> warnings;
-    if (!solver::buildBodies(mScene, bodies, errors, warnings, s.allowPaths))
+    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths))
         return sceneErrors(errors);
     for (const std::string& w : warnings) report += "gale: warning: " + w + '\n';
     if (bodies.empty()) {
@@ -43,7 +43,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
     mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads);
 
-    mWorld = std::make_unique<solver::World>(solver::worldSettings(mScene, s.threads));
+    mWorld = std::make_unique<solver::World>(scene::worldSettings(mScene, s.threads));
     mWorld->setWind(wind);
     for (auto& b : bodies) mWorld->addBody(std::move(b));
     for (const solver::Collider& c : mScene.colliders) mWorld->addCollider(c);

@@ -4,8 +4,8 @@
 // Scene.simulate (python/), so both give the same frames.
 #pragma once
 
-#include "solver/scene.h"
-#include "solver/world.h"
+#include "scene/sim_scene.h"
+#include "solver/world/world.h"
 
 #include <memory>
 #include <string>
@@ -40,7 +40,7 @@ public:
     // (the field's diagnostics, "gale: warning: ..." lines), in order, each ending in '\n'.
     RunError load(const SimSetup& setup, std::string& report);
 
-    const solver::SimScene& scene() const { return mScene; }
+    const scene::SimScene& scene() const { return mScene; }
     solver::World& world() { return *mWorld; }
     const solver::World& world() const { return *mWorld; }
     int first() const { return mFirst; }
@@ -57,7 +57,7 @@ public:
     solver::FrameStats advance(int frame) { return mWorld->advanceFrame(frame); }
 
 private:
-    solver::SimScene mScene;
+    scene::SimScene mScene;
     std::unique_ptr<solver::World> mWorld;
     int mFirst = 0, mLast = 0;
     std::string mSettings;

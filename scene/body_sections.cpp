@@ -5,9 +5,9 @@
 #include "scene/sections.h"
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
-#include "solver/mesh_collider.h"
-#include "solver/moving_collider.h"
-#include "solver/scene.h"
+#include "solver/collider/mesh_collider.h"
+#include "solver/collider/moving_collider.h"
+#include "scene/sim_scene.h"
 
 #include "lang/functions.h"
 
@@ -51,7 +51,7 @@ const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "v
 
 class Loader : public TomlReader {
 public:
-    Loader(std::string path, const std::string& text, std::vector<fields::SceneError>& errors)
+    Loader(std::string path, const std::string& text, std::vector<SceneError>& errors)
         : TomlReader(std::move(path), text, errors) {}
 
     void applySets(toml::table& root, const std::vector<std::string>& sets);
@@ -137,7 +137,7 @@ bool Loader::choice(const toml::node& n, const std::string& what, const std::vec
     if (std::find(options.begin(), options.end(), v) == options.end()) {
         std::string list;
         for (const std::string& o : options) list += (list.empty() ? "\"" : ", \"") + o + "\"";
-        fields::SceneError& e = error(n, "unknown " + what + " '" + v + "' (use " + list + ")");
+        SceneError& e = error(n, "unknown " + what + " '" + v + "' (use " + list + ")");
         const std::string hint = didYouMean(v, options);
         if (!hint.empty()) e.notes.push_back(hint);
         return false;
@@ -615,7 +615,7 @@ void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collid
     if (const toml::node* n = t.get("radius")) number(*n, what + ": radius (m)", c.radius, 0.0, true);
     if (const toml::node* n = t.get("thickness")) number(*n, what + ": thickness (m)", c.thickness, 0.0, false);
     if (const toml::node* n = t.get("friction")) number(*n, what + ": friction", c.friction, 0.0, false);
-    // A mesh: its SDF (solver/mesh_collider.h), the file relative to the scene.
+    // A mesh: its SDF (solver/collider/mesh_collider.h), the file relative to the scene.
     const toml::node* mesh = t.get("mesh");
     std::string file;
     double voxel = 0.01;
@@ -628,7 +628,7 @@ void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collid
     std::string problem;
     if (path.find('#') != std::string::npos) {
         // A per-frame sequence: triangles, a refitted tree and continuous contact
-        // (solver/moving_collider.h) instead of an SDF rebuilt every frame.
+        // (solver/collider/moving_collider.h) instead of an SDF rebuilt every frame.
         std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, fps, problem);
         if (!seq) {
             error(*mesh, what + ": " + problem);
@@ -696,7 +696,7 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
 } // namespace
 
 void loadBodySections(const std::string& path, const std::string& text, toml::table& root,
-                      SimScene& out, std::vector<fields::SceneError>& errors,
+                      SimScene& out, std::vector<SceneError>& errors,
                       const std::vector<std::string>& sets) {
     Loader loader(path, text, errors);
     loader.applySets(root, sets);

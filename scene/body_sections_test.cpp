@@ -2,7 +2,7 @@
 // values reported at file:line:col, --set overrides by dotted path, painted maps from
 // expressions, pins by box, and bodies built from grids and strand grids.
 #include "scene/load.h"
-#include "solver/scene.h"
+#include "scene/sim_scene.h"
 
 #include <catch2/catch.hpp>
 
@@ -35,7 +35,7 @@ struct TempDir {
 struct Loaded {
     bool ok = false;
     SimScene scene;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::string all() const {
         std::string s;
         for (const auto& e : errors) s += e.render() + "\n";
@@ -114,7 +114,7 @@ TEST_CASE("scene: the solver's sections with their values", "[scene]") {
     CHECK(l.scene.wind.settings.substeps == 2);
 
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
     REQUIRE(bodies.size() == 2);
@@ -222,7 +222,7 @@ drag = { source = "1 + $nope" }
 )");
     REQUIRE(l.ok);
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     CHECK_FALSE(buildBodies(l.scene, bodies, errors, warnings));
     std::string all;
@@ -262,7 +262,7 @@ pins = { map = "pin" }
     INFO(l.all());
     REQUIRE(l.ok);
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
     const Cloth& c = dynamic_cast<const Cloth&>(*bodies[0]);
@@ -314,7 +314,7 @@ pins = { box = [-0.1, -0.1, -1, 0.1, 1.1, 1], rotate = { pivot = [0, 0, 0], axis
     CHECK(p.rotate.axis == Vec3::UnitY());
     CHECK(p.rotate.angle.scalarAt(0.5) == Approx(45.0));
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
     // Vertex 4 is at (0, 1/3, 0) on the pivot's axis: it does not move; none is off it here, so
@@ -353,7 +353,7 @@ rest_shape = "flat"
     INFO(l.all());
     REQUIRE(l.ok);
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
     // a: starts flat (its positions), rest folded: bending energy > 0 at the start; the rest
@@ -416,7 +416,7 @@ mesh = "plate.#.obj"
     CHECK(l.scene.colliders[0].moving);
     CHECK(!l.scene.colliders[0].mesh);
     std::vector<std::unique_ptr<Body>> bodies;
-    std::vector<gale::fields::SceneError> errors;
+    std::vector<gale::scene::SceneError> errors;
     std::vector<std::string> warnings;
     REQUIRE(buildBodies(l.scene, bodies, errors, warnings));
     // Cloth: the 6 vertices with x ≤ 0, 1 cm above the plate, following it up (frame 3 at t = 0.3).

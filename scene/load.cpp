@@ -18,7 +18,7 @@ void startScene(const std::string& path, fields::Scene& out) {
 
 } // namespace
 
-bool loadScene(const std::string& path, fields::Scene& out, std::vector<fields::SceneError>& errors,
+bool loadScene(const std::string& path, fields::Scene& out, std::vector<SceneError>& errors,
                const SceneLoadOptions& options) {
     startScene(path, out);
     std::string text;
@@ -27,9 +27,9 @@ bool loadScene(const std::string& path, fields::Scene& out, std::vector<fields::
     return loadWindSections(path, text, root, out, errors, options);
 }
 
-bool loadSimScene(const std::string& path, solver::SimScene& out,
-                  std::vector<fields::SceneError>& errors, const std::vector<std::string>& sets) {
-    out = solver::SimScene{};
+bool loadSimScene(const std::string& path, SimScene& out,
+                  std::vector<SceneError>& errors, const std::vector<std::string>& sets) {
+    out = SimScene{};
     startScene(path, out.wind);
     SceneLoadOptions options;
     options.sets = sets;

@@ -6,9 +6,9 @@
 #include "geometry/geometry.h"
 #include "io/test_support.h"
 #include "scene/load.h"
-#include "solver/collider.h"
-#include "solver/mesh_collider.h"
-#include "solver/scene.h"
+#include "solver/collider/collider.h"
+#include "solver/collider/mesh_collider.h"
+#include "scene/sim_scene.h"
 
 #include <catch2/catch.hpp>
 
@@ -79,7 +79,7 @@ TEST_CASE("mesh collider in a scene: [[collider]] type = \"mesh\"", "[collider][
         dir.file("body.obj"), gale::geometry::boxMesh({-0.2, 0, -0.1}, {0.2, 1.6, 0.1})));
     auto load = [&](const std::string& text, SimScene& scene, std::string& all) {
         std::ofstream(dir.file("scene.toml")) << text;
-        std::vector<gale::fields::SceneError> errors;
+        std::vector<gale::scene::SceneError> errors;
         const bool ok = loadSimScene(dir.file("scene.toml"), scene, errors);
         all.clear();
         for (const auto& e : errors) all += e.render() + "\n";
@@ -120,7 +120,7 @@ TEST_CASE("multigrid: the scene key picks the preconditioner; a bad value is an 
     auto load = [&](const std::string& value, SimScene& scene, std::string& errors) {
         std::ofstream(path) << "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n"
                             << (value.empty() ? "" : "preconditioner = " + value + "\n");
-        std::vector<gale::fields::SceneError> errs;
+        std::vector<gale::scene::SceneError> errs;
         const bool ok = loadSimScene(path, scene, errs, {});
         for (const auto& e : errs) errors += e.render() + "\n";
         return ok;

@@ -13,8 +13,6 @@
 
 namespace gale::scene {
 
-using fields::SceneError;
-
 namespace {
 
 bool contains(const std::vector<std::string>& list, const std::string& s) {
@@ -232,7 +230,7 @@ std::optional<fields::Param> TomlReader::keyframes(const toml::table& t, const s
         } else if (name == "step") {
             interp = fields::KeyInterp::Step;
         } else {
-            fields::SceneError& e = error(*i, "unknown interpolation '" + name + "' for " + what +
+            SceneError& e = error(*i, "unknown interpolation '" + name + "' for " + what +
                                                   " (use \"linear\", \"smooth\" or \"step\")");
             std::string hint = didYouMean(name, {"linear", "smooth", "step"});
             if (!hint.empty()) e.notes.push_back(hint);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "fields/scene.h"
+#include "scene/error.h"
 
 #include <toml++/toml.h>
 
@@ -39,16 +40,16 @@ struct SetSections {
 
 class TomlReader {
 public:
-    TomlReader(std::string path, const std::string& text, std::vector<fields::SceneError>& errors);
+    TomlReader(std::string path, const std::string& text, std::vector<SceneError>& errors);
 
     // At a toml++ source region: the scene's file:line:col and source line, or the `--set`
     // named by the region's path.
-    fields::SceneError& error(const toml::source_region& where, std::string message);
-    fields::SceneError& error(const toml::node& at, std::string message) {
+    SceneError& error(const toml::source_region& where, std::string message);
+    SceneError& error(const toml::node& at, std::string message) {
         return error(at.source(), std::move(message));
     }
     // A problem of one `--set` (no position).
-    fields::SceneError& setError(const std::string& set, std::string message);
+    SceneError& setError(const std::string& set, std::string message);
 
     // Applies the `sets` that `sections` takes to `root` (values as TOML, a comma list of
     // numbers or a bare string; parseSetValue), each reported at its --set when it fails.
@@ -79,7 +80,7 @@ protected:
     std::string mPath;
     const std::string& mText;
     std::vector<size_t> mLineStarts;
-    std::vector<fields::SceneError>& mErrors;
+    std::vector<SceneError>& mErrors;
 };
 
 } // namespace gale::scene

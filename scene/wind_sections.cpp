@@ -482,6 +482,11 @@ bool readSceneFile(const std::string& path, std::string& text, toml::table& root
         }
         text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
+    return parseSceneText(path, text, root, errors);
+}
+
+bool parseSceneText(const std::string& path, const std::string& text, toml::table& root,
+                    std::vector<SceneError>& errors) {
     try {
         root = toml::parse(text, path);
     } catch (const toml::parse_error& e) {

@@ -1,0 +1,29 @@
+// Scene errors rendered like expression diagnostics: file:line:col, the offending line with a
+// caret under the column, then notes.
+#include "scene/error.h"
+
+namespace gale::scene {
+
+std::string SceneError::render() const {
+    std::string out = file.empty() ? std::string("<scene>") : file;
+    if (line > 0) out += ":" + std::to_string(line) + ":" + std::to_string(col > 0 ? col : 1);
+    out += ": error: " + message;
+    if (line > 0 && !sourceLine.empty()) {
+        out += "\n    ";
+        for (char c : sourceLine) out += (static_cast<unsigned char>(c) < 0x20 && c != '\t') ? ' ' : c;
+        out += "\n    ";
+        // The caret under column `col` (columns count characters; tabs are kept as tabs).
+        int column = 1;
+        for (size_t i = 0; i < sourceLine.size() && column < col; ++i) {
+            const unsigned char c = static_cast<unsigned char>(sourceLine[i]);
+            if ((c & 0xC0) == 0x80) continue; // UTF-8 continuation byte
+            out += c == '\t' ? '\t' : ' ';
+            ++column;
+        }
+        out += '^';
+    }
+    for (const std::string& n : notes) out += "\nnote: " + n;
+    return out;
+}
+
+} // namespace gale::scene

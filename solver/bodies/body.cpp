@@ -1,0 +1,865 @@
+// The linearised backward-Euler substep shared by cloth and hair.
+//
+// Baraff & Witkin, "Large Steps in Cloth Simulation", SIGGRAPH 1998, eq. (16)–(17):
+//   (M + h D + h² K) Δv = h (f₀ − h K v₀),   v₁ = v₀ + Δv,   x₁ = x₀ + h v₁
+// with K = −∂f/∂x and D = −∂f/∂v positive semi-definite, so the matrix is SPD. Pins and
+// contacts enter through the constraint filter (linear.h). Optional extra Newton iterations
+// solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
+// same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
+#include "solver/bodies/body.h"
+#include "solver/mesh/mesh_sequence.h"
+#include "solver/collider/moving_collider.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace gale::solver {
+
+namespace {
+// Flexible GMRES for the skew aerodynamic coupling (solveLinear): Krylov vectors per cycle and
+// cycles at most (each vector costs one preconditioning solve).
+constexpr int kGmresRestart = 20;
+constexpr int kGmresRestarts = 4;
+// A vertex this close to a collider's offset surface (m) counts as touching it: rounding
+// after a projection must not switch the contact off.
+constexpr double kContactSlop = 1e-7;
+} // namespace
+
+bool PaintedParam::alwaysZero() const {
+    if (!value.isKeyed()) return value.scalarAt(0.0) == 0.0;
+    for (const auto& v : value.values())
+        if (!v.empty() && v[0] != 0.0) return false;
+    return true;
+}
+
+const char* troubleName(Trouble t) {
+    switch (t) {
+    case Trouble::None:
+        return "none";
+    case Trouble::NonFinite:
+        return "non-finite state";
+    case Trouble::SolverNotConverged:
+        return "linear solver did not converge";
+    case Trouble::OverStretch:
+        return "over-stretch";
+    case Trouble::VelocityJump:
+        return "velocity jump";
+    }
+    return "?";
+}
+
+Body::Body(std::string name, const VecX& restPositions)
+    : mName(std::move(name)), mX(restPositions), mV(VecX::Zero(restPositions.size())),
+      mMass(VecX::Zero(restPositions.size() / 3)), mRest(restPositions) {}
+
+void Body::finishSetup(const std::vector<std::array<int, 2>>& edges) {
+    const size_t n = vertexCount();
+    mHeld.assign(n, 0);
+    for (size_t i = 0; i < n; ++i)
+        if (!(mMass[i] > 0.0) || !std::isfinite(mMass[i])) {
+            mHeld[i] = 1; // in no element of positive size: nothing moves it, keep it in place
+            mMass[i] = 1.0;
+        }
+    std::vector<std::pair<int, int>> pairs;
+    couplings(pairs);
+    mA.build(static_cast<int>(n), pairs);
+    mEdges = edges;
+    mEdgeRest.resize(edges.size());
+    for (size_t e = 0; e < edges.size(); ++e)
+        mEdgeRest[e] =
+            (vec3At(mRest.data(), edges[e][1]) - vec3At(mRest.data(), edges[e][0])).norm();
+    mContactImpulse.assign(n, 0.0);
+    mContactCollider.assign(n, -1);
+}
+
+void Body::addPins(const PinSet& pins) {
+    const int set = static_cast<int>(mPinSets.size());
+    mPinSets.push_back(pins);
+    for (int v : pins.vertices) {
+        if (v < 0 || static_cast<size_t>(v) >= vertexCount()) continue;
+        if (std::find(mPinned.begin(), mPinned.end(), v) != mPinned.end()) continue;
+        mPinned.push_back(v);
+        mPinSet.push_back(set);
+        mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
+                                  ? std::make_shared<const SurfaceBinding>(
+                                        bindToSurface(*pins.attach, vec3At(mX.data(), v)))
+                                  : nullptr);
+        const Vec3 p = vec3At(mX.data(), v);
+        mAnchor.conservativeResize(mAnchor.size() + 3);
+        mAnchor.tail<3>() = p;
+    }
+}
+
+namespace {
+Vec3 translationAt(const fields::Param& p, double t) {
+    double d[3] = {0.0, 0.0, 0.0};
+    if (p.width() >= 3) p.evaluate(t, d);
+    return Vec3(d[0], d[1], d[2]);
+}
+// The rotation of a PinRotation at t (identity when inactive or about a zero axis).
+Mat3 rotationAt(const PinRotation& r, double t) {
+    if (!r.active || !(r.axis.norm() > 0.0)) return Mat3::Identity();
+    const double rad = r.angle.scalarAt(t) * (M_PI / 180.0);
+    return Eigen::AngleAxisd(rad, r.axis.normalized()).toRotationMatrix();
+}
+} // namespace
+
+Vec3 Body::pinTarget(size_t k, double t) const {
+    const PinSet& set = mPinSets[mPinSet[k]];
+    if (mPinBinding[k]) return boundPosition(*set.attach, *mPinBinding[k], t);
+    const Vec3 anchor = mAnchor.segment<3>(3 * k);
+    const Vec3 rotated =
+        set.rotate.active
+            ? Vec3(set.rotate.pivot + rotationAt(set.rotate, t) * (anchor - set.rotate.pivot))
+            : anchor;
+    return rotated + translationAt(set.translate, t);
+}
+
+Vec3 Body::pinVelocity(size_t k, double t) const {
+    const PinSet& set = mPinSets[mPinSet[k]];
+    constexpr double d = 1e-6; // s: the right derivative (the motion ahead), exact on linear keys
+    if (mPinBinding[k]) return (pinTarget(k, t + d) - pinTarget(k, t)) / d;
+    Vec3 v = (translationAt(set.translate, t + d) - translationAt(set.translate, t)) / d;
+    if (set.rotate.active && set.rotate.axis.norm() > 0.0) {
+        const double omega = (set.rotate.angle.scalarAt(t + d) - set.rotate.angle.scalarAt(t)) / d *
+                             (M_PI / 180.0); // rad/s
+        const Vec3 r = rotationAt(set.rotate, t) * (mAnchor.segment<3>(3 * k) - set.rotate.pivot);
+        v += (omega * set.rotate.axis.normalized()).cross(r);
+    }
+    return v;
+}
+
+void Body::restore(const Snapshot& s) {
+    mX = s.x;
+    mV = s.v;
+    mDvGuess = s.dvGuess;
+    mHGuess = s.hGuess;
+}
+
+double Body::kineticEnergy() const {
+    double e = 0.0;
+    for (size_t i = 0; i < vertexCount(); ++i)
+        if (!mHeld[i]) e += 0.5 * mMass[i] * vec3At(mV.data(), i).squaredNorm();
+    return e;
+}
+
+double Body::potentialEnergy(const Vec3& gravity) const {
+    double e = 0.0;
+    for (size_t i = 0; i < vertexCount(); ++i)
+        if (!mHeld[i]) e -= mMass[i] * gravity.dot(vec3At(mX.data(), i));
+    return e;
+}
+
+double Body::elasticEnergy(double t) {
+    VecX f = VecX::Zero(mX.size());
+    ForceInput in;
+    in.x = mX.data();
+    in.v = mV.data();
+    in.t = t;
+    ForceOutput out;
+    out.f = &f;
+    addForces(in, out);
+    return out.elasticEnergy;
+}
+
+double Body::maxEdgeStretch() const {
+    return maxEdgeStretchOf(mX);
+}
+
+double Body::maxEdgeStretchOf(const VecX& x) const {
+    double m = 0.0;
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        if (!(mEdgeRest[e] > 0.0)) continue;
+        const double r =
+            (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
+        if (std::isnan(r)) return r; // a non-finite state is never "not stretched"
+        m = std::max(m, r);
+    }
+    return m;
+}
+
+void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity, bool withMatrix) {
+    const size_t n = vertexCount();
+    const bool matrix =
+        withMatrix && !mOptions.explicitEuler; // the explicit baseline needs forces only
+    if (matrix) mA.setZero();
+    mF.setZero(3 * n);
+    mKv.setZero(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        if (matrix) mA.addDiagonal(mA.diagonalSlot(static_cast<int>(i)), mMass[i]);
+        if (!mHeld[i]) mF.segment<3>(3 * i) += mMass[i] * gravity;
+    }
+    out.f = &mF;
+    out.kv = matrix ? &mKv : nullptr;
+    out.A = matrix ? &mA : nullptr;
+    out.aero = matrix ? &mAero : nullptr;
+    out.aeroPsd = matrix && in.aeroPosition ? &mAeroPsd : nullptr;
+    out.skewed = false;
+    if (matrix) mAero.clear();
+    addForces(in, out);
+    if (matrix) {
+        mSkewed = out.skewed;
+        mAeroPosition = in.aeroPosition && !mAero.empty();
+    }
+}
+
+void Body::evaluateKinematics(const Environment& env, double t, double h) {
+    mKin.t0 = t;
+    mKin.t1 = t + h;
+    // Pins and attachments reach their targets at t + h (backward Euler).
+    mKin.pinTargets.resize(mPinned.size());
+    for (size_t k = 0; k < mPinned.size(); ++k) mKin.pinTargets[k] = pinTarget(k, mKin.t1);
+    mKin.colliders.clear();
+    if (!env.colliders) return;
+    for (const Collider& c : *env.colliders) {
+        ColliderMotion m;
+        m.thickness = colliderThickness(c);
+        // A moving mesh's tree for the step (moving_collider.h), searched far enough to find
+        // the surface a vertex within the thickness of it is moving towards.
+        if (c.moving) c.moving->prepare(mKin.t0, mKin.t1, m.thickness);
+        m.start = colliderPose(c, mKin.t0);
+        m.end = colliderPose(c, mKin.t1);
+        if (c.moving) {
+            const double search = 2.0 * m.thickness + 1e-3;
+            m.start.searchRadius = std::max(m.start.searchRadius, search);
+            m.end.searchRadius = std::max(m.end.searchRadius, search);
+        }
+        mKin.colliders.push_back(m);
+    }
+}
+
+void Body::contactConstraints(const Environment& env, double h) {
+    std::fill(mContactImpulse.begin(), mContactImpulse.end(), 0.0);
+    std::fill(mContactCollider.begin(), mContactCollider.end(), -1);
+    if (!env.colliders || env.colliders->empty()) return;
+    const size_t n = vertexCount();
+    for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
+        const double thick = mKin.colliders[ci].thickness;
+        const ColliderPose& pose = mKin.colliders[ci].start;
+        for (size_t i = 0; i < n; ++i) {
+            if (mConstraints.kind[i] == 1) continue; // pinned or held
+            const Vec3 x = vec3At(mX.data(), i);
+            const ContactPoint cp = queryCollider(pose, x);
+            if (!(cp.distance < thick + kContactSlop)) continue;
+            // Predicted normal speed relative to the surface without the constraint: keep
+            // the vertex on the surface only if it would move in (no adhesion).
+            const Vec3 v0 = vec3At(mV.data(), i);
+            const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - cp.velocity;
+            const double un = pred.dot(cp.normal);
+            if (!(un < 0.0)) continue;
+            mConstraints.kind[i] = 2;
+            vec3At(mConstraints.normal.data(), i) = cp.normal;
+            vec3At(mConstraints.z.data(), i) = cp.normal * (cp.velocity - v0).dot(cp.normal);
+            mContactImpulse[i] = -un;
+            mContactCollider[i] = static_cast<int>(ci);
+        }
+    }
+}
+
+int Body::resolveContacts(const Environment& env, double h) {
+    if (!env.colliders || env.colliders->empty()) {
+        mTouching.clear();
+        return 0;
+    }
+    const size_t n = vertexCount();
+    std::vector<uint8_t> touched(n, 0);
+    for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
+        const Collider& c = (*env.colliders)[ci];
+        const double thick = mKin.colliders[ci].thickness;
+        const ColliderPose& pose = mKin.colliders[ci].end;
+        for (size_t i = 0; i < n; ++i) {
+            if (mConstraints.kind[i] == 1) continue;
+            Eigen::Map<Vec3> x(mX.data() + 3 * i);
+            const ContactPoint cp = queryCollider(pose, x);
+            const bool held = mContactCollider[i] == static_cast<int>(ci);
+            if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
+            if (!(cp.distance < thick) && !held) continue;
+            touched[i] = 1;
+            if (cp.distance < thick) x += (thick - cp.distance) * cp.normal;
+            Eigen::Map<Vec3> v(mV.data() + 3 * i);
+            Vec3 rel = v - cp.velocity;
+            double impulse = mContactImpulse[i]; // m/s removed by the constraint in the solve
+            const double vn = rel.dot(cp.normal);
+            if (vn < 0.0) {
+                rel -= vn * cp.normal;
+                impulse += -vn;
+            }
+            // Coulomb friction: the tangential speed drops by at most μ × the normal impulse.
+            const Vec3 vt = rel - rel.dot(cp.normal) * cp.normal;
+            const double vtn = vt.norm();
+            Vec3 slip = Vec3::Zero();
+            if (vtn > 0.0) {
+                const double keep = std::max(0.0, 1.0 - c.friction * impulse / vtn);
+                slip = (1.0 - keep) * vt;
+                rel -= slip;
+            }
+            // The position moved with the velocity before friction: take that part back too,
+            // so that x₁ = x₀ + h v₁ holds for the tangential motion.
+            x -= h * slip;
+            v = cp.velocity + rel;
+            mContactImpulse[i] = 0.0;
+            mContactCollider[i] = -1;
+        }
+    }
+    int count = 0;
+    for (uint8_t u : touched) count += u;
+    mTouching = std::move(touched);
+    return count;
+}
+
+namespace {
+// s = Σ of x over an element's corners (unused corners are −1).
+Vec3 cornerSum(const AeroCoupling& c, const VecX& x) {
+    Vec3 sum = Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+        if (c.v[k] >= 0) sum += x.segment<3>(3 * c.v[k]);
+    return sum;
+}
+} // namespace
+
+void Body::skewProduct(const VecX& x, VecX& y) const {
+    y.setZero(x.size());
+    for (const AeroCoupling& c : mAero) {
+        if (c.v[0] < 0) continue;
+        if (mAeroPosition && c.v[2] >= 0) {
+            // Newton's full Jacobian: all of ∂F/∂v beyond the damping in A, and the orientation
+            // part less its PSD part (which is in A too).
+            const Vec3 d0 = x.segment<3>(3 * c.v[0]);
+            Vec3 w = c.velocityRest * cornerSum(c, x);
+            w += c.position * ((x.segment<3>(3 * c.v[1]) - d0).cross(c.e2) +
+                               c.e1.cross(x.segment<3>(3 * c.v[2]) - d0));
+            const Mat9& psd = mAeroPsd[static_cast<size_t>(&c - mAero.data())];
+            Eigen::Matrix<double, 9, 1> xt;
+            for (int k = 0; k < 3; ++k) xt.segment<3>(3 * k) = x.segment<3>(3 * c.v[k]);
+            const Eigen::Matrix<double, 9, 1> px = psd * xt;
+            for (int k = 0; k < 3; ++k) y.segment<3>(3 * c.v[k]) += w - px.segment<3>(3 * k);
+            continue;
+        }
+        const Vec3 w = c.axis.cross(cornerSum(c, x));
+        for (int k = 0; k < 3; ++k)
+            if (c.v[k] >= 0) y.segment<3>(3 * c.v[k]) += w;
+    }
+}
+
+double Body::aeroQuadratic(const VecX& x) const {
+    double q = 0.0;
+    for (const AeroCoupling& c : mAero) {
+        if (c.v[0] < 0) continue;
+        const Vec3 sum = cornerSum(c, x);
+        q += sum.dot(c.damping * sum); // Σ_c x_cᵀ D s = sᵀ D s
+    }
+    return q;
+}
+
+// (H + B) Δv = b with H the assembled SPD matrix and B the skew part of the aerodynamic
+// Jacobian (mAero), under the constraint filter: with Δv = y + z (z prescribed, S y = y),
+//   S (H + B) S y = S (b − (H + B) z).
+// H + B is positive real (its symmetric part H is SPD), so GMRES converges; it is right-
+// preconditioned by the symmetric filtered solve itself (multigrid PCG or LDLᵀ on H, to a loose
+// tolerance: flexible GMRES, Saad 1993, since a PCG solve is not a fixed linear operator).
+// I + H⁻¹B has its eigenvalues on the line 1 + iμ, so few iterations suffice while ‖H⁻¹B‖ is
+// moderate. Started from the symmetric solution; if it does not reach the tolerance the step
+// keeps the symmetric solve (the skew part explicit, as it was before) and counts a fallback.
+SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
+    SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver,
+                                   mOptions.cgTolerance, mOptions.cgMaxIterations);
+    if (!(mSkewed || mAeroPosition) || !ls.converged || ls.failed) return ls;
+    const long n3 = b.size();
+    const auto dot = [&](const VecX& u, const VecX& w) {
+        return deterministicDot(u.data(), w.data(), static_cast<size_t>(n3));
+    };
+    VecX tmp(n3);
+    const auto op = [&](const VecX& y, VecX& out) { // out = S (H + B) y
+        out.resize(n3);
+        mA.multiply(y.data(), out.data());
+        skewProduct(y, tmp);
+        out += tmp;
+        mConstraints.apply(out.data());
+    };
+    mZeroZ = mConstraints;
+    std::fill(mZeroZ.z.begin(), mZeroZ.z.end(), 0.0);
+    const VecX z = Eigen::Map<const VecX>(mConstraints.z.data(), n3);
+    VecX rhs;
+    op(z, rhs);
+    VecX sb = b;
+    mConstraints.apply(sb.data());
+    rhs = sb - rhs;
+    const double target = mOptions.cgTolerance * std::sqrt(dot(rhs, rhs));
+    VecX y = dv - z;
+    const double precTolerance = std::max(mOptions.cgTolerance, 1e-2);
+    std::vector<VecX> V(kGmresRestart + 1), Z(kGmresRestart);
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(kGmresRestart + 1, kGmresRestart);
+    Eigen::VectorXd cs(kGmresRestart), sn(kGmresRestart), g(kGmresRestart + 1);
+    VecX r, w;
+    bool converged = false, failed = false;
+    for (int restart = 0; restart < kGmresRestarts && !converged && !failed; ++restart) {
+        op(y, r);
+        r = rhs - r;
+        const double beta = std::sqrt(dot(r, r));
+        if (!std::isfinite(beta)) {
+            failed = true;
+            break;
+        }
+        if (beta <= target) {
+            converged = true;
+            break;
+        }
+        V[0] = r / beta;
+        g.setZero();
+        g[0] = beta;
+        int k = 0;
+        for (int j = 0; j < kGmresRestart; ++j) {
+            Z[j].setZero(n3);
+            const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver,
+                                                 precTolerance, mOptions.cgMaxIterations);
+            ls.iterations += ps.iterations;
+            if (ps.failed || !Z[j].allFinite()) {
+                failed = true;
+                break;
+            }
+            op(Z[j], w);
+            for (int i = 0; i <= j; ++i) { // modified Gram–Schmidt
+                H(i, j) = dot(w, V[i]);
+                w -= H(i, j) * V[i];
+            }
+            H(j + 1, j) = std::sqrt(dot(w, w));
+            for (int i = 0; i < j; ++i) { // the earlier Givens rotations on column j
+                const double t = cs[i] * H(i, j) + sn[i] * H(i + 1, j);
+                H(i + 1, j) = -sn[i] * H(i, j) + cs[i] * H(i + 1, j);
+                H(i, j) = t;
+            }
+            const double den = std::hypot(H(j, j), H(j + 1, j));
+            cs[j] = den > 0.0 ? H(j, j) / den : 1.0;
+            sn[j] = den > 0.0 ? H(j + 1, j) / den : 0.0;
+            const double hNext = H(j + 1, j);
+            H(j, j) = den;
+            H(j + 1, j) = 0.0;
+            g[j + 1] = -sn[j] * g[j];
+            g[j] = cs[j] * g[j];
+            k = j + 1;
+            if (std::abs(g[j + 1]) <= target) {
+                converged = true;
+                break;
+            }
+            if (!(hNext > 0.0)) break; // the Krylov space is invariant: the solution is in it
+            V[j + 1] = w / hNext;
+        }
+        if (failed || k == 0) break;
+        // y += Z c with R c = g (R the leading k × k triangle).
+        const Eigen::VectorXd c =
+            H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+        for (int i = 0; i < k; ++i) y += c[i] * Z[i];
+        if (!converged) { // recheck the true residual (an invariant space, or the next restart)
+            op(y, r);
+            converged = std::sqrt(dot(rhs - r, rhs - r)) <= target;
+        }
+    }
+    // Newton's iterations (mAeroPosition) take GMRES's iterate whenever it beats the start: the
+    // symmetric solve is no Newton direction there. The linearised step keeps the fallback.
+    bool better = converged;
+    if (!converged && mAeroPosition && !failed && y.allFinite()) {
+        op(y, r);
+        const double after = std::sqrt(dot(rhs - r, rhs - r));
+        op(dv - z, r);
+        better = after < 0.5 * std::sqrt(dot(rhs - r, rhs - r));
+    }
+    if (better && y.allFinite()) {
+        dv = y + z;
+    } else {
+        ++ls.skewFallbacks; // dv keeps the symmetric solve
+    }
+    return ls;
+}
+
+double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h, ForceInput& in,
+                        ForceOutput& out, const Vec3& gravity, bool withMatrix) {
+    const size_t n = vertexCount();
+    mV = v0 + dv;
+    mX = x0 + h * mV;
+    in.x = mX.data();
+    in.v = mV.data();
+    assemble(in, out, gravity, withMatrix);
+    mG.resize(3 * n);
+    double rInf = 0.0, r2 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        Vec3 g = mMass[i] * dv.segment<3>(3 * i) - h * mF.segment<3>(3 * i);
+        const uint8_t kind = mConstraints.kind[i];
+        if (kind == 1) {
+            g.setZero();
+        } else if (kind == 2) {
+            const Vec3 nn = vec3At(mConstraints.normal.data(), i);
+            g -= g.dot(nn) * nn;
+        }
+        mG.segment<3>(3 * i) = g;
+        const double e = (mDiagInv[i] * g).norm(); // m/s
+        if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();
+        rInf = std::max(rInf, e);
+        r2 += e * e;
+    }
+    mResidual2 = std::sqrt(r2);
+    return rInf;
+}
+
+bool Body::stretchFeasible(const VecX& x) const {
+    // The over-stretch detector's rule (substep()): trouble when an edge exceeds the limit and
+    // the largest stretch grew by more than 5 %. The line search takes no step into it.
+    return maxEdgeStretchOf(x) <= std::max(mLimits.overStretch, 1.05 * mStretchBefore);
+}
+
+double Body::elasticAt(const VecX& x, double t, VecX& fEl) {
+    fEl.setZero(x.size());
+    mZero.setZero(x.size());
+    ForceInput in;
+    in.x = x.data();
+    in.v = mZero.data(); // no velocity: no damping; no wind: no aerodynamics
+    in.t = t;
+    ForceOutput out;
+    out.f = &fEl;
+    addForces(in, out);
+    return out.elasticEnergy;
+}
+
+// Newton on the backward-Euler equations in the velocity change Δv = v₁ − v₀ (x₁ = x₀ + h v₁):
+//   g(Δv) = M Δv − h f(x₀ + h v₁, v₁) = 0,   filtered by the constraints (S g = 0).
+// The first iterate is the linearised solve already in mDv (Baraff & Witkin 1998). Converged when
+// every free vertex's velocity error eᵢ = Aᵢᵢ⁻¹ S gᵢ (block-Jacobi estimate, Aᵢᵢ the diagonal
+// blocks of A at the substep's start; m/s) is below `newtonTolerance`.
+// Otherwise each iteration k solves A_k δ = −g_k, A_k = M + hD + h²K at the iterate (SPD: the
+// projected aerodynamic damping, the Gauss–Newton membrane), and takes the longest step
+// α ∈ {1, ½, ¼, …} with Armijo's decrease of the incremental potential (Gast et al. 2015) in
+// which the non-conservative forces (aerodynamics, Rayleigh damping) are frozen at the iterate:
+//   Φ_k(Δv) = ½ Δvᵀ M Δv + E(x₀ + h(v₀ + Δv)) − h G_kᵀ Δv,   G_k = f_k − f_E(x_k)
+// (E the elastic energy, f_E = −∇E; gravity is in G_k). ∇Φ_k(Δv_k) = g_k, so δ is a descent
+// direction of Φ_k for any SPD A_k, and a step that would over-stretch an edge raises E and is
+// cut. A fixed point of the iteration solves the nonlinear equations exactly, aerodynamics
+// included. The linearised iterate is checked against Δv = 0 with Φ₀ (forces frozen at x₀, v₀).
+void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
+                  const VecX& v0, double h, SubstepStatus& st) {
+    constexpr double kArmijo = 1e-4;
+    constexpr int kMaxCuts = 10;
+    const size_t n = vertexCount();
+    const double t1 = in.t;
+    mDiagInv.resize(n);
+    for (size_t i = 0; i < n; ++i)
+        mDiagInv[i] = invertBlockOrScale(mA.block(mA.diagonalSlot(static_cast<int>(i))));
+    mF0 = mF; // f(x₀, v₀)
+    double rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+    st.newtonResidual = rInf;
+    if (rInf <= mOptions.newtonTolerance) return;
+
+    // Φ along Δv = α d from base Δv_b: inertia exact, E exact, frozen forces G linear.
+    auto inertia = [&](const VecX& dv) {
+        double e = 0.0;
+        for (size_t i = 0; i < n; ++i) e += 0.5 * mMass[i] * dv.segment<3>(3 * i).squaredNorm();
+        return e;
+    };
+    // The aerodynamic force frozen at the base Δv_b decreases as the cloth follows the air: its
+    // symmetric damping enters Φ as ½ (Δv − Δv_b)ᵀ hD (Δv − Δv_b) (PSD), so that the line search
+    // does not take the frozen force for a constant one.
+    auto phi = [&](const VecX& dv, double energy, const VecX& base) {
+        return inertia(dv) + energy - h * mGk.dot(dv) + 0.5 * aeroQuadratic(dv - base);
+    };
+
+    // The linearised step against Δv = 0, with G₀ = f(x₀, v₀) − f_E(x₀).
+    const VecX dvLin = mDv;
+    elasticAt(x0, t1, mFel);
+    mGk = mF0 - mFel;
+    VecX trialX = x0 + h * v0;
+    double energy = elasticAt(trialX, t1, mFel);
+    VecX dvBase = VecX::Zero(3 * n);
+    const double phi0 = phi(dvBase, energy, dvBase);
+    double slope = -h * (mFel + mGk).dot(dvLin); // ∇Φ₀(0)·d
+    double alpha = 1.0, phiTrial = 0.0;
+    VecX fElTrial;
+    int cuts = 0;
+    for (;; ++cuts) {
+        mDv = alpha * dvLin;
+        trialX = x0 + h * (v0 + mDv);
+        const double eTrial = elasticAt(trialX, t1, fElTrial);
+        phiTrial = phi(mDv, eTrial, dvBase);
+        const bool ok = slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
+        if (ok && std::isfinite(phiTrial) && stretchFeasible(trialX)) {
+            energy = eTrial;
+            mFel = fElTrial;
+            break;
+        }
+        if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
+            mDv = dvBase;
+            energy = elasticAt(x0 + h * v0, t1, mFel);
+            break;
+        }
+        alpha *= 0.5;
+    }
+    st.lineSearchCuts += cuts;
+
+    VecX rhs(3 * n), delta(3 * n);
+    std::fill(mConstraints.z.begin(), mConstraints.z.end(), 0.0);
+    for (int k = 0;; ++k) {
+        // f_k and A_k at the iterate; g_k; G_k = f_k − f_E(x_k) (f_E from the accepted trial).
+        in.aeroPosition = mOptions.newtonFullJacobian && k < mOptions.newtonIterations;
+        rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, k < mOptions.newtonIterations);
+        in.aeroPosition = false;
+        if (rInf <= mOptions.newtonTolerance || k == mOptions.newtonIterations ||
+            !std::isfinite(rInf))
+            break;
+        mGk = mF - mFel;
+        rhs = -mG;
+        delta.setZero();
+        const SolveStatus ns = solveLinear(rhs, delta);
+        st.iterations += ns.iterations;
+        st.residual = std::max(st.residual, ns.residual);
+        ++st.newtonIterations;
+        if (ns.failed || !delta.allFinite()) break;
+        dvBase = mDv;
+        const double phiBase = phi(dvBase, energy, dvBase);
+        const double base2 = mResidual2;
+        slope = mG.dot(delta);
+        alpha = 1.0;
+        bool accepted = false;
+        for (cuts = 0; cuts <= kMaxCuts; ++cuts, alpha *= 0.5) {
+            mDv = dvBase + alpha * delta;
+            trialX = x0 + h * (v0 + mDv);
+            const double eTrial = elasticAt(trialX, t1, fElTrial);
+            phiTrial = phi(mDv, eTrial, dvBase);
+            bool ok = std::isfinite(phiTrial) &&
+                      phiTrial <= phiBase + kArmijo * alpha * std::min(slope, 0.0);
+            // With the full Jacobian δ is Newton's direction for the residual itself, which Φ_k
+            // (forces frozen) need not see decrease: a step that lowers the residual is progress.
+            if (mAeroPosition && std::isfinite(phiTrial) && !ok) {
+                residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+                ok = mResidual2 <= (1.0 - kArmijo * alpha) * base2;
+            }
+            if (ok && stretchFeasible(trialX)) {
+                energy = eTrial;
+                mFel = fElTrial;
+                accepted = true;
+                break;
+            }
+        }
+        st.lineSearchCuts += std::min(cuts, kMaxCuts);
+        if (!accepted) { // no decrease along δ (rounding at convergence): stay
+            mDv = dvBase;
+            rInf = residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
+            break;
+        }
+    }
+    st.newtonResidual = rInf;
+    st.newtonStalled = !(rInf <= mOptions.newtonTolerance);
+}
+
+int Body::recover(const Snapshot& start, double h) {
+    const size_t n = vertexCount();
+    const VecX& x0 = start.x;
+    const VecX& v0 = start.v;
+    if (!mV.allFinite() || !mX.allFinite()) {
+        mV = v0;
+        mX = x0 + h * v0;
+    }
+    if (!std::isfinite(mRecoverySpeed)) mRecoverySpeed = mLimits.velocityJump;
+    // 1. Speeds capped at the world's speed scale, velocity_jump + 2 (wind + pins) (never the
+    // cloth's own, which may be what ran away); pins keep their motion.
+    std::vector<uint8_t> fixed(n, 0);
+    for (int i : mPinned) fixed[i] = 1;
+    for (size_t i = 0; i < n; ++i) {
+        if (mHeld[i]) fixed[i] = 1;
+        if (fixed[i]) continue;
+        Eigen::Map<Vec3> v(mV.data() + 3 * i);
+        const double speed = v.norm();
+        if (!(speed <= mRecoverySpeed))
+            v = std::isfinite(speed) ? Vec3((mRecoverySpeed / speed) * v) : Vec3::Zero();
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (!fixed[i]) mX.segment<3>(3 * i) = x0.segment<3>(3 * i) + h * mV.segment<3>(3 * i);
+    // 2. Strain limiting (Provot 1995): each edge longer than s·L₀ shortened to it, the change
+    // shared by inverse mass (fixed vertices do not move), Gauss–Seidel over the edges in order.
+    int shortened = 0;
+    for (int sweep = 0; sweep < 100; ++sweep) {
+        int changed = 0;
+        for (size_t e = 0; e < mEdges.size(); ++e) {
+            const int a = mEdges[e][0], b = mEdges[e][1];
+            const double wa = fixed[a] ? 0.0 : 1.0 / mMass[a], wb = fixed[b] ? 0.0 : 1.0 / mMass[b];
+            if (wa + wb == 0.0) continue;
+            Eigen::Map<Vec3> xa(mX.data() + 3 * a), xb(mX.data() + 3 * b);
+            const Vec3 d = xb - xa;
+            const double len = d.norm(), cap = mRecoveryStretch * mEdgeRest[e];
+            if (!(len > cap * (1.0 + 1e-9)) || !(len > 0.0)) continue;
+            const Vec3 corr = ((len - cap) / len) * d;
+            xa += (wa / (wa + wb)) * corr;
+            xb -= (wb / (wa + wb)) * corr;
+            ++changed;
+        }
+        shortened += changed;
+        if (changed == 0) break;
+    }
+    // 3. Velocities from the corrected positions, x₁ = x₀ + h v₁.
+    for (size_t i = 0; i < n; ++i)
+        if (!fixed[i]) mV.segment<3>(3 * i) = (mX.segment<3>(3 * i) - x0.segment<3>(3 * i)) / h;
+    mDvGuess = mV - v0;
+    return shortened;
+}
+
+SubstepStatus Body::substep(const Environment& env, double t, double h) {
+    SubstepStatus st;
+    const size_t n = vertexCount();
+    const VecX x0 = mX, v0 = mV;
+    const double stretchBefore = mEdges.empty() ? 0.0 : maxEdgeStretch();
+    mStretchBefore = stretchBefore;
+    evaluateKinematics(env, t, h);
+
+    // 1. Wind at the vertices, once per substep, as one batch.
+    const bool aero = feelsWind();
+    double maxWind = 0.0;
+    if (aero) {
+        mWind.setZero(3 * n);
+        if (env.wind) {
+            fields::SampleTime when;
+            when.time = t;
+            when.fps = env.fps;
+            when.substep = env.substepIndex;
+            when.threads = env.threads;
+            const fields::SampleStatus ss = env.wind->sample(mX.data(), n, when, mWind.data());
+            size_t bad = 0;
+            for (size_t i = 0; i < 3 * n; ++i)
+                if (!std::isfinite(mWind[i])) {
+                    mWind[i] = 0.0;
+                    ++bad;
+                }
+            st.windNonFinite = std::max(ss.nonFinite, bad);
+            if (!ss.ok || st.windNonFinite) {
+                st.windMessage =
+                    ss.message.empty()
+                        ? std::to_string(st.windNonFinite) +
+                              " wind sample(s) were not finite and were replaced by zero"
+                        : ss.message;
+                if (st.windNonFinite == 0 && !ss.ok) st.windNonFinite = 1;
+            }
+        }
+        for (size_t i = 0; i < n; ++i) maxWind = std::max(maxWind, vec3At(mWind.data(), i).norm());
+    }
+
+    // 2. Forces, K v and the matrix M + hD + h²K at (x₀, v₀).
+    ForceInput in;
+    in.x = mX.data();
+    in.v = mV.data();
+    in.wind = aero ? mWind.data() : nullptr;
+    in.t = t;
+    in.h = h;
+    in.airDensity = env.airDensity;
+    in.aeroJacobian = mOptions.aeroJacobian;
+    ForceOutput out;
+    assemble(in, out, env.gravity);
+    st.clampedJacobians = out.clamped;
+    mB = h * (mF - h * mKv);
+
+    // 3. Constraints: pins reach their target at t + h; held vertices stay; contacts.
+    mConstraints.reset(n);
+    double pinSpeed = 0.0;
+    for (size_t k = 0; k < mPinned.size(); ++k) {
+        const int i = mPinned[k];
+        mConstraints.kind[i] = 1;
+        const Vec3 vTarget = (mKin.pinTargets[k] - vec3At(x0.data(), i)) / h;
+        vec3At(mConstraints.z.data(), i) = vTarget - vec3At(v0.data(), i);
+        pinSpeed = std::max(pinSpeed, vTarget.norm());
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (mHeld[i]) {
+            mConstraints.kind[i] = 1;
+            vec3At(mConstraints.z.data(), i) = -vec3At(v0.data(), i);
+        }
+    contactConstraints(env, h);
+
+    // 4. Solve, warm-started from the previous substep's Δv scaled to this step.
+    SolveStatus ls;
+    if (mOptions.explicitEuler) {
+        // The explicit baseline: Δv = h M⁻¹ f, constrained vertices as prescribed.
+        mDv.resize(3 * n);
+        for (size_t i = 0; i < n; ++i) {
+            Vec3 dv = (h / mMass[i]) * vec3At(mF.data(), i);
+            if (mConstraints.kind[i] == 1) {
+                dv = vec3At(mConstraints.z.data(), i);
+            } else if (mConstraints.kind[i] == 2) {
+                const Vec3 nn = vec3At(mConstraints.normal.data(), i);
+                dv += nn * (vec3At(mConstraints.z.data(), i).dot(nn) - dv.dot(nn));
+            }
+            mDv.segment<3>(3 * i) = dv;
+        }
+        ls.converged = true;
+    } else {
+        if (mOptions.warmStart && mDvGuess.size() == static_cast<long>(3 * n) && mHGuess > 0.0 &&
+            mDvGuess.allFinite())
+            mDv = mDvGuess * (h / mHGuess);
+        else
+            mDv.setZero(3 * n);
+        mSolver.setPreconditioner(mOptions.preconditioner);
+        ls = solveLinear(mB, mDv);
+    }
+    st.iterations = ls.iterations;
+    st.residual = ls.residual;
+    st.converged = ls.converged && !ls.failed;
+
+    // 5. Newton on the backward-Euler residual, from the linearised solve as the first iterate.
+    if (st.converged && !mOptions.explicitEuler && mOptions.newtonIterations > 0)
+        newton(env, in, out, x0, v0, h, st);
+    mDvGuess = mDv;
+    mHGuess = h;
+    mV = v0 + mDv;
+    mX = x0 + h * mV;
+
+    // 6. Colliders: moving meshes first swept continuously over the step (no vertex or edge
+    // crosses the surface, moving_collider.h), then push out, approach speed, Coulomb friction.
+    if (env.colliders)
+        for (const Collider& c : *env.colliders)
+            if (c.moving) {
+                std::vector<uint8_t> movable(n);
+                for (size_t i = 0; i < n; ++i) movable[i] = mConstraints.kind[i] != 1;
+                c.moving->sweep(x0, mX, mV, movable, mEdges, colliderThickness(c), c.friction, h);
+            }
+    st.contacts = resolveContacts(env, h);
+
+    // 7. Trouble detection.
+    double maxSpeed = 0.0, maxJump = 0.0, maxSpeed0 = 0.0;
+    bool finite = mX.allFinite() && mV.allFinite();
+    if (finite)
+        for (size_t i = 0; i < n; ++i) {
+            if (mHeld[i]) continue;
+            maxSpeed = std::max(maxSpeed, vec3At(mV.data(), i).norm());
+            maxSpeed0 = std::max(maxSpeed0, vec3At(v0.data(), i).norm());
+            if (mConstraints.kind[i] != 1)
+                maxJump = std::max(maxJump, (vec3At(mV.data(), i) - vec3At(v0.data(), i)).norm());
+        }
+    st.maxSpeed = maxSpeed;
+    st.maxStretch = finite && !mEdges.empty() ? maxEdgeStretch() : 0.0;
+    mRecoverySpeed = mLimits.velocityJump + 2.0 * (maxWind + pinSpeed); // the world's speed scale
+    mRecoveryStretch = std::max(1.1, std::min(stretchBefore, mLimits.overStretch));
+    char buf[200];
+    if (!finite || ls.failed) {
+        st.trouble = Trouble::NonFinite;
+        st.reason = !finite ? "positions or velocities became non-finite"
+                            : "the linear solve produced non-finite values";
+    } else if (!st.converged) {
+        st.trouble = Trouble::SolverNotConverged;
+        std::snprintf(buf, sizeof buf, "residual %.3g after %d iterations (tolerance %.3g)",
+                      st.residual, st.iterations, mOptions.cgTolerance);
+        st.reason = buf;
+    } else if (st.maxStretch > mLimits.overStretch && st.maxStretch > 1.05 * stretchBefore) {
+        st.trouble = Trouble::OverStretch;
+        std::snprintf(buf, sizeof buf, "an edge reached %.3g× its rest length (limit %.3g×)",
+                      st.maxStretch, mLimits.overStretch);
+        st.reason = buf;
+    } else {
+        const double limit = mRecoverySpeed;
+        if (maxJump > limit) {
+            st.trouble = Trouble::VelocityJump;
+            std::snprintf(buf, sizeof buf,
+                          "a vertex changed speed by %.3g m/s in one substep "
+                          "(limit %.3g m/s)",
+                          maxJump, limit);
+            st.reason = buf;
+        }
+    }
+    return st;
+}
+
+} // namespace gale::solver

@@ -1,0 +1,314 @@
+// A simulated body (cloth or hair): particle state, lumped masses, pins, and the linearised
+// backward-Euler substep (Baraff & Witkin 1998) shared by every kind of body. Subclasses
+// supply the pattern of coupled vertices and their forces with SPD Jacobians.
+#pragma once
+
+#include "fields/field.h"
+#include "fields/keyframes.h"
+#include "solver/bodies/aero.h"
+#include "solver/bodies/kinematics.h"
+#include "solver/collider/collider.h"
+#include "solver/linalg/linear.h"
+#include "solver/linalg/types.h"
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+class MeshSequence; // solver/mesh/mesh_sequence.h
+struct SurfaceBinding;
+
+// A scalar that is keyframable (`value`) and optionally painted per vertex (`map`, multiplied).
+struct PaintedParam {
+    fields::Param value{1.0};
+    std::vector<double> map; // per vertex, empty: 1 everywhere
+
+    double at(double t) const { return value.scalarAt(t); }
+    bool painted() const { return !map.empty(); }
+    // True when the value is zero at every key (and the constant): the term can be skipped.
+    bool alwaysZero() const;
+};
+
+// A keyframable rotation of pinned vertices by `angle` (degrees, right-handed) about the line
+// through `pivot` along `axis` (world space, fixed).
+struct PinRotation {
+    bool active = false;
+    Vec3 pivot = Vec3::Zero();
+    Vec3 axis = Vec3::UnitY();
+    fields::Param angle{0.0}; // degrees, scalar keys
+};
+
+// Pinned vertices, held at their initial positions moved rigidly by a keyframable rotation about
+// a pivot, then a keyframable translation (Houdini/Maya order: rotate about the pivot, then
+// translate): target(t) = pivot + R(t)(x_start − pivot) + translate(t). With `attach`, each
+// vertex is instead bound (when added) to its closest point on that mesh's first frame and
+// follows it (mesh_sequence.h, SurfaceBinding): an attachment, a hard constraint like a pin.
+struct PinSet {
+    std::vector<int> vertices;
+    fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}}; // m, vector keys
+    PinRotation rotate;
+    std::shared_ptr<const MeshSequence> attach;
+};
+
+// Numerical settings of a body's substep.
+struct StepOptions {
+    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    LinearSolverKind linearSolver = LinearSolverKind::Pcg;
+    Preconditioner preconditioner =
+        Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
+    double cgTolerance = 1e-3;     // relative residual of the filtered system
+    int cgMaxIterations = 2000;
+    // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):
+    // at most `newtonIterations` corrections, until every free vertex's velocity residual
+    // error Aᵢᵢ⁻¹ S gᵢ is below
+    // `newtonTolerance` (m/s).
+    int newtonIterations = 0;
+    double newtonTolerance = 0.01;
+    // Newton's iterations solve with the full Jacobian: also how the aerodynamic force turns
+    // with each triangle (∂F/∂x) and the parts of ∂F/∂v the symmetric damping drops, by GMRES.
+    // Off: the SPD linearisation of every iterate (cheaper; no quadratic convergence).
+    bool newtonFullJacobian = true;
+    bool warmStart = true; // start CG from the previous substep's Δv
+    // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
+    // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
+    bool explicitEuler = false;
+};
+
+// What a substep sees of the world.
+struct Environment {
+    const fields::Field* wind = nullptr; // summed scene fields (may be null: still air)
+    double airDensity = 1.225;           // kg/m³
+    Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+    const std::vector<Collider>* colliders = nullptr;
+    double fps = 24.0;
+    int threads = 1;
+    int substepIndex = 0;
+};
+
+// Contact settings of a body (cloth): cloth–cloth collision (solver/world/self_collision.h) and the
+// collision thickness ξ (m) it keeps from itself and other cloth; against colliders the larger
+// of ξ and the collider's own thickness applies when `thicknessForColliders` is set (a cloth
+// with an explicit `thickness` in the scene).
+struct CollisionSettings {
+    bool self = false;
+    double thickness = 0.003;
+    bool thicknessForColliders = false;
+};
+
+// Why a substep was rejected (the caller halves the step and retries).
+enum class Trouble { None, NonFinite, SolverNotConverged, OverStretch, VelocityJump };
+const char* troubleName(Trouble t);
+
+struct SubstepStatus {
+    Trouble trouble = Trouble::None;
+    std::string reason;    // human-readable detail of the trouble
+    int iterations = 0;    // linear-solver iterations (all Newton iterations)
+    double residual = 0.0; // the largest relative residual of those solves
+    bool converged = true;
+    int newtonIterations = 0;    // Newton corrections after the linearised solve
+    double newtonResidual = 0.0; // m/s: the largest free vertex's velocity residual at the end
+    int lineSearchCuts = 0;      // step halvings of the Newton line search
+    bool newtonStalled = false;  // stopped above the tolerance: no step lowered the merit
+    size_t windNonFinite = 0;    // wind samples that came back NaN/inf (replaced by zero)
+    std::string windMessage;
+    int clampedJacobians = 0; // paper Jacobian with C_D < C_L, clamped
+    double maxSpeed = 0.0;    // m/s after the step
+    double maxStretch = 0.0;  // largest edge length / rest length after the step
+    int contacts = 0;         // vertices touching a collider after the step
+};
+
+// Limits of the trouble detectors.
+struct TroubleLimits {
+    double overStretch = 3.0;   // edge length / rest length that counts as over-stretched
+    double velocityJump = 50.0; // m/s: a |Δv| larger than this and than 2× the speed scale
+};
+
+// One element's aerodynamic linearisation (ForceOutput::aero); unused corners are −1. With
+// s = Σ_{c in element} x_c, every corner c gets (A x)_c += damping s + axis × s: `damping` the
+// symmetric part (already in A), `axis` the skew part (a cloth triangle: (h/9) D and (h/9) ω).
+struct AeroCoupling {
+    std::array<int, 3> v{-1, -1, -1};
+    Mat3 damping = Mat3::Zero();
+    Vec3 axis = Vec3::Zero();
+    // Newton's full Jacobian only (ForceInput::aeroPosition): the force's dependence on the
+    // triangle's orientation, −h²∂f/∂x δ at every corner = P((δ₁ − δ₀) × e₂ + e₁ × (δ₂ − δ₀)),
+    // P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner).
+    Mat3 position = Mat3::Zero();
+    Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero();
+    // ... and what `damping` leaves out of the exact (h/9)∂F/∂v (its whole skew part, ungated,
+    // and the clamped negative part): Newton's iterations solve with the exact Jacobian, this
+    // in place of `axis`.
+    Mat3 velocityRest = Mat3::Zero();
+};
+
+// What a body's force routine reads and writes.
+struct ForceInput {
+    const double* x = nullptr;
+    const double* v = nullptr;
+    const double* wind = nullptr; // per vertex, null when the body feels no wind
+    double t = 0.0, h = 0.0;
+    double airDensity = 1.225;
+    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    bool aeroPosition = false; // also the orientation part of ∂F/∂x (AeroCoupling::position)
+};
+struct ForceOutput {
+    VecX* f = nullptr;          // forces (N), accumulated
+    VecX* kv = nullptr;         // K v (N/s) with K = −∂f/∂x, accumulated (null: not needed)
+    BlockMatrix* A = nullptr;   // h·D + h²·K accumulated (null: forces only)
+    double elasticEnergy = 0.0; // J
+    int clamped = 0;
+    // The aerodynamic linearisation per element when asked for (one slot each; empty: none).
+    std::vector<AeroCoupling>* aero = nullptr;
+    // With ForceInput::aeroPosition: per triangle, the PSD part of the symmetrised orientation
+    // Jacobian (9×9, corners' blocks), also added to A so that the preconditioner sees it; the
+    // rest of AeroCoupling::position stays in the Krylov operator.
+    std::vector<Mat9>* aeroPsd = nullptr;
+    bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
+};
+
+class Body {
+public:
+    virtual ~Body() = default;
+    Body(const Body&) = delete;
+    Body& operator=(const Body&) = delete;
+
+    const std::string& name() const { return mName; }
+    size_t vertexCount() const { return mMass.size(); }
+    const VecX& positions() const { return mX; }
+    const VecX& velocities() const { return mV; }
+    const VecX& masses() const { return mMass; } // kg per vertex
+    // Replace state (e.g. a pre-stretched start, or a resumed run). Sizes must match.
+    void setPositions(const VecX& x) { mX = x; }
+    void setVelocities(const VecX& v) { mV = v; }
+    // Overrides lumped masses (kg per vertex; e.g. tests of equal-mass chains).
+    void setMasses(const VecX& m) { mMass = m; }
+    StepOptions& options() { return mOptions; }
+    const StepOptions& options() const { return mOptions; }
+    TroubleLimits& limits() { return mLimits; }
+    CollisionSettings& collision() { return mCollision; }
+    const CollisionSettings& collision() const { return mCollision; }
+    // The triangles cloth–cloth contact sees (null: a body without a surface, e.g. hair).
+    virtual const std::vector<std::array<int, 3>>* collisionTriangles() const { return nullptr; }
+    const VecX& restPositions() const { return mRest; } // 3 per vertex (m)
+    // Per vertex: touching a collider after the last substep (empty: no colliders).
+    const std::vector<uint8_t>& colliderContacts() const { return mTouching; }
+
+    void addPins(const PinSet& pins);
+    const std::vector<int>& pinnedVertices() const { return mPinned; }
+    // Pin target position of vertex index `k` in pinnedVertices() at time t.
+    Vec3 pinTarget(size_t k, double t) const;
+    // Its velocity d/dt of the rigid motion at t (m/s): ω × R(x_start − pivot) + d(translate)/dt,
+    // the key curves' right derivatives (over 1e-6 s). The substep itself moves a pin along the
+    // chord (target(t + h) − x₀)/h, so that x₁ lands exactly on the motion (backward Euler).
+    Vec3 pinVelocity(size_t k, double t) const;
+
+    // One linearised backward-Euler substep from t to t + h. Updates the state even when the
+    // status reports trouble: the caller keeps a snapshot and decides.
+    SubstepStatus substep(const Environment& env, double t, double h);
+
+    // Whether any force of this body reads the wind (aerodynamic coefficients not all zero).
+    virtual bool feelsWind() const = 0;
+    virtual const char* kind() const = 0;
+
+    // The full state a bit-identical continuation needs (positions, velocities, warm start).
+    struct Snapshot {
+        VecX x, v, dvGuess;
+        double hGuess = 0.0;
+    };
+    Snapshot snapshot() const { return {mX, mV, mDvGuess, mHGuess}; }
+    void restore(const Snapshot& s);
+
+    // The last line of defence at the smallest substep (World): from the state a troubled
+    // substep left, speeds capped at the world's speed scale, then strain limiting (no edge
+    // longer than max(1.1, the stretch at the substep's start, capped at over_stretch) × its
+    // rest length) and velocities consistent with the positions. Always finite. Returns the
+    // number of edge corrections.
+    int recover(const Snapshot& start, double h);
+
+    double kineticEnergy() const;
+    double potentialEnergy(const Vec3& gravity) const; // −Σ m g·x (J)
+    double elasticEnergy(double t);                    // J, at the current positions
+    double maxEdgeStretch() const;                     // max |e| / |e_rest|
+    double maxEdgeStretchOf(const VecX& x) const;      // the same at positions x (NaN if any is)
+    const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
+
+protected:
+    Body(std::string name, const VecX& restPositions);
+
+    // Vertex pairs coupled by any element (for the matrix pattern), edges for the stretch
+    // monitor; call once from the subclass constructor via `finishSetup`.
+    virtual void couplings(std::vector<std::pair<int, int>>& pairs) const = 0;
+    virtual void addForces(const ForceInput& in, ForceOutput& out) = 0;
+    void finishSetup(const std::vector<std::array<int, 2>>& edges);
+    const BlockMatrix& matrix() const { return mA; }
+
+    std::string mName;
+    VecX mX, mV, mMass, mRest;
+    StepOptions mOptions;
+    TroubleLimits mLimits;
+    CollisionSettings mCollision;
+
+private:
+    // The thickness kept from collider c (m): its own, or the body's when larger and asked for.
+    double colliderThickness(const Collider& c) const {
+        return mCollision.thicknessForColliders ? std::max(c.thickness, mCollision.thickness)
+                                                : c.thickness;
+    }
+    // Everything scripted for the substep [t, t + h] into mKin (kinematics.h), once.
+    void evaluateKinematics(const Environment& env, double t, double h);
+    void contactConstraints(const Environment& env, double h);
+    int resolveContacts(const Environment& env, double h);
+    void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
+                  bool withMatrix = true);
+    // The filtered backward-Euler residual g at Δv into mG (mX, mV, mF, and A when asked, left
+    // there); returns max |Aᵢᵢ⁻¹ S gᵢ| (m/s), infinite when not finite.
+    double residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h, ForceInput& in,
+                      ForceOutput& out, const Vec3& gravity, bool withMatrix);
+    // y = B x, B the skew part of the couplings in mAero (in Newton's iterations, mAeroPosition,
+    // all of the Jacobian the assembled A lacks); aeroQuadratic: xᵀ D x of their symmetric part.
+    void skewProduct(const VecX& x, VecX& y) const;
+    double aeroQuadratic(const VecX& x) const;
+    // The linear solve of the step with the assembled matrix and the skew couplings.
+    SolveStatus solveLinear(const VecX& b, VecX& dv);
+    // Whether no edge at positions x is over-stretched by the trouble detector's rule.
+    bool stretchFeasible(const VecX& x) const;
+    // Elastic energy (J) and conservative elastic forces f_E = −∇E (N) at positions x.
+    double elasticAt(const VecX& x, double t, VecX& fEl);
+    void newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
+                const VecX& v0, double h, SubstepStatus& st);
+
+    StepKinematics mKin; // the substep's scripted motion (evaluateKinematics)
+    std::vector<int> mPinned; // vertex per pin
+    std::vector<int> mPinSet; // index into mPinSets per pin
+    std::vector<PinSet> mPinSets;
+    std::vector<std::shared_ptr<const SurfaceBinding>>
+        mPinBinding;            // per pin: its attachment, or null
+    VecX mAnchor;               // 3 per pin: initial position
+    std::vector<uint8_t> mHeld; // vertices in no element: held in place
+    std::vector<std::array<int, 2>> mEdges;
+    std::vector<double> mEdgeRest;
+    BlockMatrix mA;
+    FilteredSolver mSolver;
+    Constraints mConstraints;
+    std::vector<double> mContactImpulse; // per vertex: suppressed normal speed (m/s)
+    std::vector<int> mContactCollider;   // per vertex: collider holding it in the solve, or -1
+    std::vector<uint8_t> mTouching;      // per vertex: touching a collider after the substep
+    VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
+    std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
+    bool mSkewed = false;            // ... with a skew part somewhere
+    bool mAeroPosition = false;      // ... with the orientation part (Newton's iterations)
+    std::vector<Mat9> mAeroPsd;
+    double mResidual2 = 0.0; // residualAt()'s 2-norm of the velocity residual (m/s)      // ... its
+                             // PSD part, in A (ForceOutput::aeroPsd)
+    double mStretchBefore = 0.0; // the largest edge stretch at the substep's start
+    double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
+    Constraints mZeroZ;         // mConstraints with z = 0 (solveLinear's preconditioner)
+    std::vector<Mat3> mDiagInv; // Newton's residual weights (body.cpp, newton())
+    double mHGuess = 0.0;
+};
+
+} // namespace gale::solver

@@ -1,0 +1,361 @@
+// The moving-mesh contact: tree refits per step, closest points at the step's ends, and the
+// CCD pass. The response to a hit at time τ (the surface point q with weights w, the normal n
+// from the surface towards the cloth at τ):
+//   x₁ ← q(t₁) + ξ n₁   (n₁: the face normal at t₁ on the side of n; for an edge hit, the
+//                         cloth edge moved by the shortfall along n, split by its weights as in
+//                         Bridson, Fedkiw & Anderson 2002, §7.1),
+//   u = v₁ − v_s,  u ← u − min(0, u·n₁) n₁,  |u_t| ← max(0, |u_t| − μ |min(0, u·n₁)|),
+// v_s = Σ w_k (p_k(t₁) − p_k(t₀))/h the surface velocity: contact and friction in the moving
+// frame of the body. Each pass re-checks the moved trajectories x₀ → x₁; a vertex still hitting
+// after the last pass is left at its last projection (counted as unresolved).
+#include "solver/collider/moving_collider.h"
+
+#include "solver/collider/collider.h"
+#include "solver/contact/ccd.h"
+#include "solver/mesh/mesh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace gale::solver {
+
+namespace {
+double seconds(std::chrono::steady_clock::time_point a) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
+}
+// A cull before the CCD that gives its answer without its first distance: contact::accd
+// (ccd.cpp) returns "no contact" at its first safe advance when stepFraction (d − ξ)/l_p ≥ 1,
+// d the start distance and l_p its bound on the relative speed (the corners' displacements
+// less their mean: the largest of each primitive's, summed, rounded up by 1e-12). With
+// `lower` ≤ d (the distance between the two primitives' boxes at the start, a lower bound) the
+// same holds for d, so the pair is clear. `lower` is shrunk by 1e-12 of the scale first (the
+// rounding of d is near 16ε of it), and l_p is taken 1e-9 larger than accd's: only pairs that
+// accd certainly rejects at its first test are culled, so the hits are those of the CCD alone.
+bool clearAtFirstAdvance(const Vec3 x[4], const Vec3 x1[4], int firstCount, double lower,
+                         const contact::CcdOptions& opt) {
+    Vec3 dx[4], mean = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) {
+        dx[i] = x1[i] - x[i];
+        mean += dx[i];
+    }
+    mean /= 4.0;
+    double scale = 1.0, la = 0.0, lb = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        double& l = i < firstCount ? la : lb;
+        l = std::max(l, (dx[i] - mean).norm());
+        scale = std::max(scale, x[i].cwiseAbs().maxCoeff());
+    }
+    lower -= 1e-12 * scale;
+    const double xi = opt.thickness;
+    if (!(lower > xi + 2e-12 * scale + opt.gapTolerance)) return false; // near: let ACCD decide
+    const double lp = (la + lb) * (1.0 + 1e-9);
+    return opt.stepFraction * (lower - xi) >= lp * (1.0 + 1e-9);
+}
+
+double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+    return std::sqrt((alo - bhi).cwiseMax(blo - ahi).cwiseMax(0.0).squaredNorm());
+}
+
+} // namespace
+
+MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
+    : mMesh(std::move(mesh)) {
+    mEdges = meshEdges(mMesh->triangles());
+}
+
+Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
+    return vec3At((atEnd ? mP1 : mP0).data(), v);
+}
+
+Vec3 MovingMeshContact::faceNormal(bool atEnd, int tri) const {
+    const auto& t = mMesh->triangles()[tri];
+    const Vec3 a = corner(atEnd, t[0]);
+    const Vec3 n = (corner(atEnd, t[1]) - a).cross(corner(atEnd, t[2]) - a);
+    const double l = n.norm();
+    return l > 0.0 ? Vec3(n / l) : Vec3::UnitY();
+}
+
+void MovingMeshContact::prepare(double t0, double t1, double margin) {
+    if (mBuilt && t0 == mT0 && t1 == mT1 && margin == mMargin) return;
+    const auto start = std::chrono::steady_clock::now();
+    if (!(mBuilt && t0 == mT1))
+        mMesh->positionsAt(t0, mP0);
+    else
+        mP0.swap(mP1); // consecutive steps: the last end is this start
+    mMesh->positionsAt(t1, mP1);
+    mT0 = t0;
+    mT1 = t1;
+    mMargin = margin;
+    // A primitive's box over the step: its corners at both ends, inflated by the margin.
+    const auto sweptBox = [&](const int* v, int count) {
+        contact::Box b;
+        for (int c = 0; c < count; ++c) {
+            b.add(corner(false, v[c]));
+            b.add(corner(true, v[c]));
+        }
+        b.inflate(margin);
+        return b;
+    };
+    const auto& tris = mMesh->triangles();
+    mBoxes.resize(tris.size());
+    for (size_t k = 0; k < tris.size(); ++k) mBoxes[k] = sweptBox(tris[k].data(), 3);
+    // The body's edges get their own tree: an edge–edge query then meets only the edges whose
+    // swept boxes reach the cloth edge's, not every edge of every triangle it reaches (each
+    // three times, to be sorted and made unique).
+    mEdgeBoxes.resize(mEdges.size());
+    for (size_t e = 0; e < mEdges.size(); ++e) mEdgeBoxes[e] = sweptBox(mEdges[e].data(), 2);
+    if (!mBuilt) {
+        mBvh.build(mBoxes);
+        mEdgeBvh.build(mEdgeBoxes);
+        mBuilt = true;
+    } else {
+        mBvh.refit(mBoxes);
+        mEdgeBvh.refit(mEdgeBoxes);
+    }
+    ++mStats.refits;
+    mStats.refitSeconds += seconds(start);
+}
+
+bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const {
+    out.distance = INFINITY;
+    if (!mBuilt) return false;
+    contact::Box q;
+    q.add(x);
+    q.inflate(radius);
+    double best = radius * radius;
+    int bestTri = -1;
+    double bestW[3] = {0, 0, 0};
+    const auto& tris = mMesh->triangles();
+    // A nearest-point walk: a node or triangle whose box is farther than the best distance so
+    // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
+    // it is skipped; the rest is visited in the order of a plain box query, so the result is the
+    // same. `slack` covers the rounding of the distances (about 16ε of |x|², far below it).
+    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
+    mBvh.traverse([&](const contact::Box& b) { return b.overlaps(q) && b.distance2(x) <= reach(); },
+                  [&](int k, const contact::Box& b) {
+                      if (!b.overlaps(q) || b.distance2(x) > reach()) return;
+                      double w[3];
+                      const double d2 = contact::pointTriangleDistance2(
+                          x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]),
+                          corner(atEnd, tris[k][2]), w);
+                      if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
+                          best = d2;
+                          bestTri = k;
+                          std::copy(w, w + 3, bestW);
+                      }
+                  });
+    if (bestTri < 0) return false;
+    const auto& t = tris[bestTri];
+    Vec3 p = Vec3::Zero(), v = Vec3::Zero();
+    const double h = mT1 - mT0;
+    for (int c = 0; c < 3; ++c) {
+        p += bestW[c] * corner(atEnd, t[c]);
+        if (h > 0.0) v += bestW[c] * (corner(true, t[c]) - corner(false, t[c])) / h;
+    }
+    const Vec3 d = x - p;
+    const double dist = d.norm();
+    const Vec3 fn = faceNormal(atEnd, bestTri);
+    out.distance = dist;
+    out.normal = dist > 1e-12 ? Vec3(d / dist) : fn;
+    out.velocity = v;
+    return true;
+}
+
+int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
+                             const std::vector<uint8_t>& movable,
+                             const std::vector<std::array<int, 2>>& edges, double thickness,
+                             double friction, double h, int passes) {
+    if (!mBuilt) return 0;
+    const size_t n = x0.size() / 3;
+    const auto& tris = mMesh->triangles();
+    // The continuous pass keeps motions from coming closer than half the thickness (a crossing
+    // needs less); hits are placed at the full thickness, so that a re-check of the corrected
+    // motion has half the thickness to spare (no re-hit on resting contact), and the push-out
+    // after it (Body::resolveContacts) restores the full thickness everywhere else.
+    // Already within the thickness at the start (resting contact): only crossing is caught
+    // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
+    contact::CcdOptions opt;
+    opt.thickness = 0.5 * thickness;
+    opt.shrinkWithinThickness = true;
+    std::vector<int> cand;
+    std::vector<uint8_t> moved(n, 0);
+    int movedCount = 0;
+    // The velocity response at vertex i against a surface point moving at vs, normal n1.
+    auto respond = [&](int i, const Vec3& vs, const Vec3& n1) {
+        Eigen::Map<Vec3> v(v1.data() + 3 * i);
+        Vec3 u = v - vs;
+        const double un = u.dot(n1);
+        if (un < 0.0) {
+            u -= un * n1;
+            const Vec3 ut = u - n1 * u.dot(n1);
+            const double ts = ut.norm();
+            if (ts > 0.0) u -= std::min(1.0, friction * (-un) / ts) * ut;
+        }
+        v = vs + u;
+        if (!moved[i]) {
+            moved[i] = 1;
+            ++movedCount;
+        }
+    };
+    auto surfaceVelocity = [&](int tri, const double w[3]) {
+        Vec3 vs = Vec3::Zero();
+        if (h > 0.0)
+            for (int c = 0; c < 3; ++c)
+                vs += w[c] * (corner(true, tris[tri][c]) - corner(false, tris[tri][c])) / h;
+        return vs;
+    };
+    auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
+    for (int pass = 0; pass < passes; ++pass) {
+        int hits = 0;
+        // Vertices against triangles.
+        for (size_t i = 0; i < n; ++i) {
+            if (!movable[i]) continue;
+            const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
+            if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
+            auto tb = std::chrono::steady_clock::now();
+            contact::Box q;
+            q.add(p0);
+            q.add(p1);
+            q.inflate(thickness);
+            double first = 2.0;
+            int hitTri = -1;
+            cand.clear();
+            mBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            mStats.broadSeconds += seconds(tb);
+            mStats.candidates += static_cast<long long>(cand.size());
+            auto tn = std::chrono::steady_clock::now();
+            for (int k : cand) {
+                const auto& t = tris[k];
+                double toi;
+                const Vec3 s0[4] = {p0, corner(false, t[0]), corner(false, t[1]),
+                                    corner(false, t[2])};
+                const Vec3 s1[4] = {p1, corner(true, t[0]), corner(true, t[1]), corner(true, t[2])};
+                const Vec3 lo = s0[1].cwiseMin(s0[2]).cwiseMin(s0[3]),
+                           hi = s0[1].cwiseMax(s0[2]).cwiseMax(s0[3]);
+                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
+                if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
+                                               corner(false, t[1]), corner(true, t[1]),
+                                               corner(false, t[2]), corner(true, t[2]), opt, toi) &&
+                    toi < first) {
+                    first = toi;
+                    hitTri = k;
+                }
+            }
+            if (hitTri >= 0) {
+                const auto& t = tris[hitTri];
+                double w[3];
+                const Vec3 a = lerp(corner(false, t[0]), corner(true, t[0]), first),
+                           b = lerp(corner(false, t[1]), corner(true, t[1]), first),
+                           c = lerp(corner(false, t[2]), corner(true, t[2]), first);
+                const Vec3 pt = lerp(p0, p1, first);
+                contact::pointTriangleDistance2(pt, a, b, c, w);
+                const Vec3 q0 = w[0] * a + w[1] * b + w[2] * c;
+                Vec3 nt = pt - q0;
+                const Vec3 fnt = (b - a).cross(c - a);
+                if (!(nt.norm() > 1e-12)) nt = fnt.dot(p0 - q0) >= 0.0 ? fnt : Vec3(-fnt);
+                const Vec3 fn1 = faceNormal(true, hitTri);
+                // The side the vertex is on, carried to the end of the step with the face.
+                Vec3 n1 = fn1.dot(nt) >= 0.0 ? fn1 : Vec3(-fn1);
+                // Off a face's interior use the direction to the closest point's feature instead
+                // (edges and corners: the normal of the face does not separate there).
+                const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
+                if (!interior) n1 = nt.normalized();
+                Vec3 q1 = Vec3::Zero();
+                for (int k = 0; k < 3; ++k) q1 += w[k] * corner(true, t[k]);
+                vec3At(x1.data(), i) = q1 + (thickness * (1.0 + 1e-6) + 1e-9) * n1;
+                respond(static_cast<int>(i), surfaceVelocity(hitTri, w), n1);
+                ++hits;
+                ++mStats.vertexHits;
+            }
+            mStats.narrowSeconds += seconds(tn);
+        }
+        // Cloth edges against body edges.
+        for (const auto& e : edges) {
+            const int i = e[0], j = e[1];
+            if (!movable[i] && !movable[j]) continue;
+            const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
+            const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
+            if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
+            auto tb = std::chrono::steady_clock::now();
+            contact::Box q;
+            q.add(a0);
+            q.add(a1);
+            q.add(b0);
+            q.add(b1);
+            q.inflate(thickness);
+            cand.clear();
+            // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
+            // of the triangles reached whose boxes do not are farther than the thickness from
+            // the cloth edge throughout the step (their boxes are inflated by the margin, the
+            // query by the thickness, and CCD asks for half of it), so they cannot be hit.
+            mEdgeBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            std::sort(cand.begin(), cand.end());
+            mStats.broadSeconds += seconds(tb);
+            mStats.candidates += static_cast<long long>(cand.size());
+            auto tn = std::chrono::steady_clock::now();
+            double first = 2.0;
+            int hitEdge = -1;
+            for (int k : cand) {
+                const int r = mEdges[k][0], s = mEdges[k][1];
+                double toi;
+                const Vec3 s0[4] = {a0, b0, corner(false, r), corner(false, s)};
+                const Vec3 s1[4] = {a1, b1, corner(true, r), corner(true, s)};
+                if (clearAtFirstAdvance(s0, s1, 2,
+                                        boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0),
+                                               s0[2].cwiseMin(s0[3]), s0[2].cwiseMax(s0[3])),
+                                        opt))
+                    continue;
+                if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
+                                         corner(false, s), corner(true, s), opt, toi) &&
+                    toi < first) {
+                    first = toi;
+                    hitEdge = k;
+                }
+            }
+            if (hitEdge >= 0) {
+                const int r = mEdges[hitEdge][0], s = mEdges[hitEdge][1];
+                double sa, sb;
+                const Vec3 pa = lerp(a0, a1, first), pb = lerp(b0, b1, first);
+                const Vec3 pr = lerp(corner(false, r), corner(true, r), first),
+                           ps = lerp(corner(false, s), corner(true, s), first);
+                contact::segmentSegmentDistance2(pa, pb, pr, ps, sa, sb);
+                Vec3 nt = (pa + sa * (pb - pa)) - (pr + sb * (ps - pr));
+                if (!(nt.norm() > 1e-12)) nt = (pb - pa).cross(ps - pr);
+                if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
+                const Vec3 nn = nt.normalized();
+                // At the end: the body point and the cloth point at the same parameters.
+                const Vec3 r1 = corner(true, r), s1 = corner(true, s);
+                const Vec3 body1 = r1 + sb * (s1 - r1);
+                Eigen::Map<Vec3> xa(x1.data() + 3 * i), xb(x1.data() + 3 * j);
+                const Vec3 cloth1 = xa + sa * (xb - xa);
+                const double gap = (cloth1 - body1).dot(nn);
+                const double want = thickness * (1.0 + 1e-6) + 1e-9;
+                if (gap < want) {
+                    // Move the cloth point by (want − gap) n: the edge's vertices by their
+                    // weights, scaled so the interpolated point moves exactly that far.
+                    const double wa = movable[i] ? 1.0 - sa : 0.0, wb = movable[j] ? sa : 0.0;
+                    const double norm = wa * (1.0 - sa) + wb * sa;
+                    if (norm > 1e-12) {
+                        const Vec3 d = ((want - gap) / norm) * nn;
+                        xa += wa * d;
+                        xb += wb * d;
+                    }
+                }
+                Vec3 vs = Vec3::Zero();
+                if (h > 0.0)
+                    vs = ((1.0 - sb) * (r1 - corner(false, r)) + sb * (s1 - corner(false, s))) / h;
+                if (movable[i]) respond(i, vs, nn);
+                if (movable[j]) respond(j, vs, nn);
+                ++hits;
+                ++mStats.edgeHits;
+            }
+            mStats.narrowSeconds += seconds(tn);
+        }
+        if (hits == 0) break;
+        if (pass == passes - 1) mStats.unresolved += hits;
+    }
+    return movedCount;
+}
+
+} // namespace gale::solver

@@ -1,0 +1,70 @@
+// Moving and deforming mesh colliders (a MeshSequence): per substep the triangles' corners at
+// both ends of the step, their swept boxes refitted into one AABB tree (built once), closest-point
+// queries at the ends (the in-solve constraints and the thickness push-out, with the surface
+// velocity of the motion), and the continuous pass that keeps cloth from crossing the surface
+// during the step: vertex–triangle and edge–edge CCD (solver/contact/ccd.h) with a thickness.
+#pragma once
+
+#include "solver/contact/bvh.h"
+#include "solver/mesh/mesh_sequence.h"
+#include "solver/linalg/types.h"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace gale::solver {
+
+struct ContactPoint; // collider.h
+
+// Timings and counts of the contact work (accumulated; bench and run statistics).
+struct MovingContactStats {
+    double refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0;
+    long long refits = 0, candidates = 0, vertexHits = 0, edgeHits = 0, unresolved = 0;
+};
+
+class MovingMeshContact {
+public:
+    explicit MovingMeshContact(std::shared_ptr<const MeshSequence> mesh);
+
+    const MeshSequence& mesh() const { return *mMesh; }
+    // The step [t0, t1]: corners at both ends, swept triangle boxes inflated by `margin` (m),
+    // the tree refitted (built on the first call). Cached: the same interval twice is free.
+    void prepare(double t0, double t1, double margin);
+    double t0() const { return mT0; }
+    double t1() const { return mT1; }
+
+    // The closest surface point to x at the start (atEnd false) or end of the prepared step,
+    // searched within `radius`: unsigned distance (m; +inf beyond radius), the unit normal from
+    // the surface towards x (the face normal when x is on it), and the surface velocity there
+    // (the mean over the step, m/s). Returns false when nothing is within radius.
+    bool closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const;
+
+    // The continuous pass over the prepared step for one body: vertex i moves from x0 to x1
+    // (where `movable[i]`), edges as given. Where a vertex or an edge would come within
+    // `thickness` of the moving surface, it is placed at `thickness` off the surface point it
+    // met, as that point is at the step's end, its approach speed removed (relative to the
+    // surface), and Coulomb friction μ applied to the tangential speed. Repeated (at most
+    // `passes` times) until no motion meets the surface. Returns the vertices moved.
+    int sweep(const VecX& x0, VecX& x1, VecX& v1, const std::vector<uint8_t>& movable,
+              const std::vector<std::array<int, 2>>& edges, double thickness, double friction,
+              double h, int passes = 4);
+
+    const MovingContactStats& stats() const { return mStats; }
+
+private:
+    Vec3 corner(bool atEnd, int v) const;
+    Vec3 faceNormal(bool atEnd, int tri) const;
+
+    std::shared_ptr<const MeshSequence> mMesh;
+    std::vector<std::array<int, 2>> mEdges; // unique body edges
+    std::vector<double> mP0, mP1;           // corners at t0 and t1
+    std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
+    std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
+    contact::Bvh mBvh, mEdgeBvh;
+    bool mBuilt = false;
+    double mT0 = NAN, mT1 = NAN, mMargin = NAN;
+    MovingContactStats mStats;
+};
+
+} // namespace gale::solver

@@ -1,0 +1,535 @@
+// Aggregation AMG preconditioner for the filtered cloth system and its BSR matrix (see
+// multigrid.h). References: Vaněk, Mandel, Brezina, "Algebraic multigrid by smoothed
+// aggregation", Computing 56 (1996); Tamstorf, Jones, McCormick, "Smoothed aggregation
+// multigrid for cloth simulation", SIGGRAPH Asia 2015.
+#include "solver/linalg/multigrid.h"
+
+#include "solver/linalg/bsr_kernels.h"
+#include "solver/linalg/linear.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+namespace gale::solver {
+
+namespace {
+
+// Blocks are stored column-major, 9 values each (bsr_kernels.h).
+using BlockMap = Eigen::Map<Mat3>;
+using ConstBlockMap = Eigen::Map<const Mat3>;
+
+// The multicolour ordering of a level (types.h, ColouredBlocks): its rows, in natural order, cut
+// into blocks of `rowBlock`; two blocks neighbour when a row of one shares a matrix block
+// with a row of the other. Without `multicolour`: the natural order, one block.
+ColouredBlocks colourRows(bool multicolour, int rowBlock, int n, const int* start,
+                          const int* cols) {
+    if (!multicolour || rowBlock <= 0 || n <= rowBlock) return naturalBlocks(n);
+    std::vector<std::vector<int>> near((n + rowBlock - 1) / rowBlock);
+    for (int i = 0; i < n; ++i) {
+        std::vector<int>& nb = near[i / rowBlock];
+        for (int k = start[i]; k < start[i + 1]; ++k)
+            if (cols[k] / rowBlock != i / rowBlock) nb.push_back(cols[k] / rowBlock);
+    }
+    for (std::vector<int>& nb : near) {
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    return colourBlocks(n, rowBlock, near);
+}
+
+int slotIn(const BsrMatrix& m, int i, int j) {
+    auto b = m.cols.begin() + m.start[i], e = m.cols.begin() + m.start[i + 1];
+    return static_cast<int>(std::lower_bound(b, e, j) - m.cols.begin());
+}
+
+// diag and mirror of a pattern with sorted columns, symmetric, the diagonal present.
+void finishPattern(BsrMatrix& m) {
+    m.diag.resize(m.n);
+    m.mirror.resize(m.cols.size());
+    for (int i = 0; i < m.n; ++i) {
+        m.diag[i] = slotIn(m, i, i);
+        for (int k = m.start[i]; k < m.start[i + 1]; ++k) m.mirror[k] = slotIn(m, m.cols[k], i);
+    }
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BsrMatrix
+
+void BsrMatrix::multiply(const double* x, double* y) const {
+    const BsrPattern p = pattern();
+    parallelChunks(static_cast<size_t>(n), 512,
+                   [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
+}
+
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single) const {
+    const size_t n3 = 3 * static_cast<size_t>(n);
+    const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
+    const size_t rowsPerChunk = kReduceChunk / 3;
+    const BsrPattern p = pattern();
+    partial.assign(chunks, 0.0);
+    parallelChunks(chunks, 1, [&](size_t c0, size_t c1) {
+        for (size_t ch = c0; ch < c1; ++ch) {
+            const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
+            const size_t i0 = ch * rowsPerChunk;
+            if (single) bsrMultiplyRows(p, single, x, y, i0, i1);
+            else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
+            double s = 0.0;
+            for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
+            partial[ch] = s;
+        }
+    });
+    double s = 0.0;
+    for (double p : partial) s += p;
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: set-up
+
+BlockMultigrid::Settings& BlockMultigrid::defaults() {
+    static Settings settings;
+    return settings;
+}
+
+// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
+// slot k holds A's slot mSrcSlot[k]).
+void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
+    mLevels.assign(1, Level());
+    Level& L = mLevels[0];
+    BsrMatrix& a = L.a;
+    const int n = A.size();
+    const std::vector<int>& start = A.blockRowStart();
+    const std::vector<int>& cols = A.blockCols();
+    L.colouring =
+        colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
+    mOrder = L.colouring.order;
+    L.visit.resize(n);
+    for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
+    a.n = n;
+    a.start.assign(n + 1, 0);
+    a.cols.clear();
+    mSrcSlot.clear();
+    std::vector<std::pair<int, int>> row; // (level-0 column, A's slot)
+    for (int p = 0; p < n; ++p) {
+        const int i = mOrder[p];
+        row.clear();
+        for (int k = start[i]; k < start[i + 1]; ++k) row.push_back({L.visit[cols[k]], k});
+        std::sort(row.begin(), row.end());
+        for (const auto& e : row) {
+            a.cols.push_back(e.first);
+            mSrcSlot.push_back(e.second);
+        }
+        a.start[p + 1] = static_cast<int>(a.cols.size());
+    }
+    finishPattern(a);
+    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
+    mPatternRows = A.size();
+    mPatternSlots = A.slotCount();
+}
+
+// Vaněk–Mandel–Brezina aggregation on the graph of the pattern of `fine` (values are not
+// read: a resumed run, which sees other first values, builds the same hierarchy bit for bit),
+// rows visited in their natural order (fine.visit); builds the pattern of `coarse` — its rows
+// (the aggregates, numbered in the order they were found) coloured and renumbered in colour
+// order — and the slot maps.
+void BlockMultigrid::aggregate(Level& fine, Level& coarse) {
+    const BsrMatrix& a = fine.a;
+    const int n = a.n;
+    std::vector<int> agg(n, -1), size;
+    // 1. Roots: a vertex whose neighbours are all unaggregated starts an aggregate with them.
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
+        if (agg[i] >= 0) continue;
+        bool free = true;
+        for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
+            if (agg[a.cols[k]] >= 0) free = false;
+        if (!free) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) agg[a.cols[k]] = static_cast<int>(size.size());
+        size.push_back(a.start[i + 1] - a.start[i]);
+    }
+    // 2. The rest join the smallest neighbouring aggregate (ties: the lower index), decided
+    // from the phase-1 labels only, so the order of the rows does not matter.
+    std::vector<int> joined = agg;
+    for (int i = 0; i < n; ++i) {
+        if (agg[i] >= 0) continue;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+            const int J = agg[a.cols[k]];
+            if (J >= 0 && (joined[i] < 0 || size[J] < size[joined[i]] || (size[J] == size[joined[i]] && J < joined[i])))
+                joined[i] = J;
+        }
+    }
+    // 3. Left-overs (no aggregated neighbour) form aggregates with their unaggregated neighbours.
+    int count = static_cast<int>(size.size());
+    for (int s = 0; s < n; ++s) {
+        const int i = fine.visit[s];
+        if (joined[i] >= 0) continue;
+        joined[i] = count;
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            if (joined[a.cols[k]] < 0) joined[a.cols[k]] = count;
+        ++count;
+    }
+    // The coarse graph in the aggregates' natural numbering, coloured in that order; coarse
+    // row P is aggregate order[P].
+    std::vector<std::vector<int>> rows(count);
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            rows[joined[i]].push_back(joined[a.cols[k]]);
+    std::vector<int> natStart(count + 1, 0), natCols;
+    for (int I = 0; I < count; ++I) {
+        std::sort(rows[I].begin(), rows[I].end());
+        rows[I].erase(std::unique(rows[I].begin(), rows[I].end()), rows[I].end());
+        natCols.insert(natCols.end(), rows[I].begin(), rows[I].end());
+        natStart[I + 1] = static_cast<int>(natCols.size());
+    }
+    coarse.colouring = colourRows(mSettings.multicolour, mSettings.rowBlock, count, natStart.data(),
+                                  natCols.data());
+    const std::vector<int>& order = coarse.colouring.order;
+    coarse.visit.resize(count);
+    for (int P = 0; P < count; ++P) coarse.visit[order[P]] = P;
+    fine.agg.resize(n);
+    for (int i = 0; i < n; ++i) fine.agg[i] = coarse.visit[joined[i]];
+    fine.memberStart.assign(count + 1, 0);
+    for (int i = 0; i < n; ++i) ++fine.memberStart[fine.agg[i] + 1];
+    for (int I = 0; I < count; ++I) fine.memberStart[I + 1] += fine.memberStart[I];
+    fine.members.resize(n);
+    {
+        std::vector<int> fill(fine.memberStart.begin(), fine.memberStart.end() - 1);
+        for (int i = 0; i < n; ++i) fine.members[fill[fine.agg[i]]++] = i;
+    }
+    // Coarse pattern: (agg i, agg j) for every fine block (i, j), in the coarse numbering.
+    BsrMatrix& c = coarse.a;
+    c.n = count;
+    c.start.assign(count + 1, 0);
+    c.cols.clear();
+    std::vector<int> row;
+    for (int P = 0; P < count; ++P) {
+        row.clear();
+        for (int k = natStart[order[P]]; k < natStart[order[P] + 1]; ++k)
+            row.push_back(coarse.visit[natCols[k]]);
+        std::sort(row.begin(), row.end());
+        c.cols.insert(c.cols.end(), row.begin(), row.end());
+        c.start[P + 1] = static_cast<int>(c.cols.size());
+    }
+    finishPattern(c);
+    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
+    fine.coarseSlot.resize(a.cols.size());
+    for (int i = 0; i < n; ++i)
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+            fine.coarseSlot[k] = slotIn(c, fine.agg[i], fine.agg[a.cols[k]]);
+    // The same map inverted, for the coarsening's gather: the fine slots of each coarse slot in
+    // increasing order.
+    fine.gatherStart.assign(c.cols.size() + 1, 0);
+    for (int K : fine.coarseSlot) ++fine.gatherStart[K + 1];
+    for (size_t K = 0; K < c.cols.size(); ++K) fine.gatherStart[K + 1] += fine.gatherStart[K];
+    fine.gather.resize(a.cols.size());
+    std::vector<int> fill(fine.gatherStart.begin(), fine.gatherStart.end() - 1);
+    for (int k = 0; k < a.blocks(); ++k) fine.gather[fill[fine.coarseSlot[k]]++] = k;
+}
+
+// A_{l+1} = P_lᵀ A_l P_l: a sum of blocks; at level 0 the constrained diagonals lose their
+// I − S part and aggregates with a direction no member can move in get an identity there.
+void BlockMultigrid::coarsen(int l) {
+    Level& f = mLevels[l];
+    BsrMatrix& c = mLevels[l + 1].a;
+    const BsrMatrix& a = f.a;
+    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
+    parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
+        for (int K = c.start[I0]; K < c.start[I1]; ++K) {
+            double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+            for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
+                const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
+                for (int q = 0; q < 9; ++q) sum[q] += src[q];
+            }
+            std::copy(sum, sum + 9, c.val.data() + 9 * static_cast<size_t>(K));
+        }
+    });
+    if (l != 0 || mKind.empty()) return;
+    for (int i = 0; i < a.n; ++i) {
+        if (!mKind[i]) continue;
+        // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
+        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.agg[i]])) -=
+            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+    }
+    for (int I = 0; I < c.n; ++I) {
+        bool any = false;
+        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) any = any || mKind[f.members[m]];
+        if (!any) continue;
+        Mat3 B = Mat3::Zero();
+        for (int m = f.memberStart[I]; m < f.memberStart[I + 1]; ++m) {
+            const int i = f.members[m];
+            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+        }
+        Eigen::SelfAdjointEigenSolver<Mat3> es(B);
+        BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
+        const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
+        for (int e = 0; e < 3; ++e)
+            if (es.eigenvalues()[e] < 1e-8) {
+                const Vec3 v = es.eigenvectors().col(e);
+                d += scale * v * v.transpose();
+            }
+    }
+}
+
+bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, const std::vector<int>& constrained) {
+    const bool fresh = mLevels.empty() || mPatternRows != A.size() || mPatternSlots != A.slotCount();
+    if (fresh) buildHierarchy(A);
+    // Level 0: Â = S A S + I − S.
+    BsrMatrix& a = mLevels[0].a;
+    const int n = a.n;
+    // One pass over A, rows in parallel: the double copy in level-0 order, its single-precision
+    // twin for the smoother and the CG products, and the finiteness check.
+    std::vector<float>& low = mLevels[0].lowVal;
+    low.resize(a.val.size());
+    std::fill(low.end() - kBsrPad, low.end(), 0.0f);
+    std::atomic<uint32_t> anyBad{0};
+    parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
+        const double* __restrict src = A.values();
+        double* __restrict dst = a.val.data();
+        float* __restrict lo = low.data();
+        const int k0 = a.start[i0], k1 = a.start[i1];
+        for (int k = k0; k < k1; ++k) {
+            const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
+            for (int q = 0; q < 9; ++q) {
+                dst[9 * static_cast<size_t>(k) + q] = s[q];
+                lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
+            }
+        }
+        // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or
+        // a value beyond float range, which the smoother could not use either); integer bit
+        // tests vectorise where isfinite on doubles does not.
+        uint32_t bad = 0;
+        for (size_t q = 9 * static_cast<size_t>(k0); q < 9 * static_cast<size_t>(k1); ++q) {
+            uint32_t bits;
+            std::memcpy(&bits, lo + q, sizeof bits);
+            bad |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+        }
+        if (bad) anyBad.fetch_or(1u, std::memory_order_relaxed);
+    });
+    if (anyBad.load()) return false;
+    auto lower = [&](int k) {
+        for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
+            low[q] = static_cast<float>(a.val[q]);
+    };
+    mKind.clear();
+    if (!constrained.empty()) {
+        mKind.assign(n, 0);
+        mNormal.assign(3 * static_cast<size_t>(n), 0.0);
+        for (int v : constrained) { // A's row v is level-0 row visit[v]
+            const int i = mLevels[0].visit[v];
+            mKind[i] = cons.kind[v];
+            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
+        }
+        for (int v : constrained) {
+            const int i = mLevels[0].visit[v];
+            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
+                row = (S * row).eval();
+                BlockMap col(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]));
+                col = (col * S).eval();
+                lower(k);
+                lower(a.mirror[k]);
+            }
+            BlockMap(a.val.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+            lower(a.diag[i]);
+        }
+    }
+    // Coarse levels: aggregate on first sight of the pattern, then sum.
+    for (int l = 0;; ++l) {
+        if (fresh) {
+            if (mLevels[l].a.n <= mSettings.coarsest) break;
+            Level next;
+            aggregate(mLevels[l], next);
+            if (5 * next.a.n > 4 * mLevels[l].a.n) { // coarsening stalls: stop here
+                mLevels[l].agg.clear();
+                break;
+            }
+            mLevels.push_back(std::move(next));
+        } else if (l + 1 >= static_cast<int>(mLevels.size())) {
+            break;
+        }
+        coarsen(l);
+    }
+    for (Level& L : mLevels) {
+        if (&L != &mLevels[0]) { // level 0's copy was made above
+            L.lowVal.resize(L.a.val.size());
+            parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+                for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+            });
+        }
+        L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
+        std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
+        // The inverse of the single-precision diagonal, so that every sweep reads one matrix
+        // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
+        parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+            for (size_t i = i0; i < i1; ++i) {
+                const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+                BlockMap(L.dinv.data() + 9 * i) =
+                    invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
+            }
+        });
+        const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+        L.r.resize(n3);
+        L.x.resize(n3);
+        L.rp = L.r.data();
+        L.xp = L.x.data();
+        L.t.resize(n3);
+    }
+    // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
+    // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
+    const BsrMatrix& c = mLevels.back().a;
+    mCoarseOk = false;
+    if (c.n > 2 * std::max(mSettings.coarsest, 1)) return true;
+    mCoarseDense.setZero(3 * c.n, 3 * c.n);
+    for (int I = 0; I < c.n; ++I)
+        for (int k = c.start[I]; k < c.start[I + 1]; ++k)
+            mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) = ConstBlockMap(c.val.data() + 9 * static_cast<size_t>(k));
+    mCoarseLlt.compute(mCoarseDense);
+    mCoarseOk = mCoarseLlt.info() == Eigen::Success;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BlockMultigrid: the V-cycle
+
+bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
+    Level& L = mLevels[l];
+    const BsrMatrix& a = L.a;
+    const int n = a.n;
+    double* x = L.xp;
+    const double* r = L.rp;
+    if (mSettings.gaussSeidel) {
+        GaussSeidelSweep g;
+        g.pattern = a.pattern();
+        g.val = L.lowVal.data();
+        g.mirror = a.mirror.data();
+        g.dinv = L.dinv.data();
+        g.r = r;
+        g.x = x;
+        g.t = residual ? L.t.data() : nullptr;
+        g.forward = forward;
+        g.fromZero = fromZero && forward;
+        const bool parallel =
+            n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
+        // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
+        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
+        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
+        // the same sums in the same order.
+        if (parallel) g.t = nullptr;
+        forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
+            GaussSeidelSweep part = g;
+            part.begin = static_cast<int>(i0);
+            part.end = static_cast<int>(i1);
+            gaussSeidelSweep(part);
+        });
+        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
+    }
+    // Damped block Jacobi: x += ω D⁻¹ (r − A x).
+    const double w = mSettings.jacobiWeight;
+    if (!fromZero) a.multiply(x, L.t.data());
+    parallelChunks(static_cast<size_t>(n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            double y[3];
+            for (int q = 0; q < 3; ++q) y[q] = r[3 * i + q] - (fromZero ? 0.0 : L.t[3 * i + q]);
+            const double* d = L.dinv.data() + 9 * i;
+            for (int q = 0; q < 3; ++q) {
+                const double v = w * (d[3 * q] * y[0] + d[3 * q + 1] * y[1] + d[3 * q + 2] * y[2]);
+                x[3 * i + q] = fromZero ? v : x[3 * i + q] + v;
+            }
+        }
+    });
+    return false;
+}
+
+void BlockMultigrid::cycle(int l) {
+    Level& L = mLevels[l];
+    const size_t n3 = 3 * static_cast<size_t>(L.a.n);
+    if (l + 1 == static_cast<int>(mLevels.size())) {
+        if (mCoarseOk) {
+            Eigen::Map<VecX>(L.xp, n3) = mCoarseLlt.solve(Eigen::Map<const VecX>(L.rp, n3));
+        } else { // a symmetric pair of sweeps, the first from zero
+            smooth(l, true, true);
+            smooth(l, false, false);
+        }
+        return;
+    }
+    // x = 0 on entry: the first sweep starts from zero and writes every row without reading
+    // its old value, so no fill is needed (only without sweeps).
+    if (mSettings.sweeps < 1) std::fill(L.xp, L.xp + n3, 0.0);
+    // t = r − A x. After one forward Gauss–Seidel sweep from zero, rows up to i already
+    // satisfy their equation: t_i = −Σ_{j>i} A_ij x_j, which that sweep accumulates itself.
+    const BsrMatrix& a = L.a;
+    const bool fused = mSettings.gaussSeidel && mSettings.sweeps == 1;
+    bool pull = false; // t_i = −Σ_{j>i} A_ij x_j still to be pulled, row by row
+    for (int s = 0; s < mSettings.sweeps; ++s) pull = smooth(l, true, s == 0, fused);
+    if (!fused) {
+        a.multiply(L.xp, L.t.data());
+        for (size_t k = 0; k < n3; ++k) L.t[k] = L.rp[k] - L.t[k];
+    }
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    Level& C = mLevels[l + 1];
+    const BsrPattern p = a.pattern();
+    const bool filtered = l == 0 && !mKind.empty();
+    parallelChunks(static_cast<size_t>(C.a.n), 64, [&](size_t I0, size_t I1) {
+        for (size_t I = I0; I < I1; ++I) {
+            Vec3 s = Vec3::Zero();
+            for (int m = L.memberStart[I]; m < L.memberStart[I + 1]; ++m) {
+                const int i = L.members[m];
+                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
+                Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
+                if (filtered && mKind[i])
+                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                s += t;
+            }
+            for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
+        }
+    });
+    cycle(l + 1);
+    // x += α S P_tent e.
+    const double alpha = mSettings.coarseWeight;
+    parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            const int I = L.agg[i];
+            Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
+        }
+    });
+    for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+}
+
+void BlockMultigrid::toLevelOrder(const double* natural, double* level) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                level[3 * p + q] = natural[3 * static_cast<size_t>(mOrder[p]) + q];
+    });
+}
+
+void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const {
+    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+        for (size_t p = p0; p < p1; ++p)
+            for (int q = 0; q < 3; ++q)
+                natural[3 * static_cast<size_t>(mOrder[p]) + q] = level[3 * p + q];
+    });
+}
+
+double BlockMultigrid::apply(const double* r, double* z) {
+    // Level 0 reads r and writes x = z in place: no copies in or out.
+    Level& L = mLevels[0];
+    L.rp = r;
+    L.xp = z;
+    cycle(0);
+    L.rp = L.r.data();
+    L.xp = L.x.data();
+    return deterministicDot(r, z, 3 * static_cast<size_t>(L.a.n));
+}
+
+} // namespace gale::solver

@@ -1,0 +1,63 @@
+// Animated triangle meshes from per-frame files (`body.#.obj` -> body.0001.obj, ..., OBJ or PLY;
+// the `#` rule of vdb() and meshvel(), geometry/file_policy.h): one topology for every frame,
+// positions linear in time within a frame (frame F at t = F / fps), held before the first and
+// after the last. A plain file name is a one-frame (static) sequence.
+#pragma once
+
+#include "solver/linalg/types.h"
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+class MeshSequence {
+public:
+    // Loads every frame of `path` (resolved; a '#' run in the file name for a sequence). Null with
+    // `error` naming the file: unreadable, a frame missing between the first and the last found
+    // on disk, or a frame whose vertex count or faces differ from the first's.
+    static std::shared_ptr<const MeshSequence> load(const std::string& path, double fps,
+                                                    std::string& error);
+    // From positions already in memory (frames[k] is frame firstFrame + k; tests, generators).
+    MeshSequence(std::vector<std::array<int, 3>> triangles, std::vector<std::vector<double>> frames,
+                 long firstFrame, double fps);
+
+    size_t vertexCount() const { return mFrames.empty() ? 0 : mFrames[0].size() / 3; }
+    const std::vector<std::array<int, 3>>& triangles() const { return mTriangles; }
+    size_t frameCount() const { return mFrames.size(); }
+    long firstFrame() const { return mFirstFrame; }
+    double fps() const { return mFps; }
+    bool moving() const { return mFrames.size() > 1; }
+    const std::string& path() const { return mPath; }
+
+    // Vertex positions at time t (3 per vertex), linear between the two frames around t·fps.
+    void positionsAt(double t, std::vector<double>& out) const;
+    // The positions of the first frame (the bind pose of attachments).
+    const std::vector<double>& firstPositions() const { return mFrames.front(); }
+    // One vertex at time t (the same interpolation as positionsAt).
+    Vec3 vertexAt(int v, double t) const;
+
+private:
+    std::vector<std::array<int, 3>> mTriangles;
+    std::vector<std::vector<double>> mFrames;
+    long mFirstFrame = 0;
+    double mFps = 24.0;
+    std::string mPath;
+};
+
+// A point bound to a mesh's surface (attachments): its closest triangle at the first frame,
+// the barycentric weights of the closest point q there, and the point's offset from q in the
+// triangle's frame (ê₁ along the first edge, n̂ the face normal, n̂ × ê₁), so that it follows
+// the triangle rigidly — exactly its own position at the bind frame, and q + offset·n̂ when it
+// lies over the face's interior.
+struct SurfaceBinding {
+    int triangle = -1;
+    double w[3] = {0, 0, 0};
+    Vec3 local = Vec3::Zero();
+};
+SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x);
+Vec3 boundPosition(const MeshSequence& mesh, const SurfaceBinding& b, double t);
+
+} // namespace gale::solver

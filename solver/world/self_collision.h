@@ -1,0 +1,130 @@
+// Cloth against itself and against other cloth: after each base substep of every colliding body,
+// a pass over their combined vertices that keeps the motion from x₀ to x₁ free of crossings —
+// proximity repulsion to the thickness, continuous collision (vertex–triangle and edge–edge
+// CCD with a thickness, solver/contact/ccd.h) with inelastic corrections, and rigid impact zones
+// as the fail-safe (Bridson, Fedkiw & Anderson 2002; Harmon et al. 2008). docs/solver.md.
+#pragma once
+
+#include "solver/bodies/body.h"
+#include "solver/contact/bvh.h"
+
+#include <array>
+#include <utility>
+#include <vector>
+
+namespace gale::solver {
+
+// Counts and timings of the passes (accumulated; run statistics and the benchmark).
+struct SelfCollisionStats {
+    long long passes = 0;         // substeps resolved
+    long long proximityPairs = 0; // pairs found closer than the thickness at x₁
+    long long ccdHits = 0;        // CCD hits corrected
+    long long ccdRounds = 0;      // CCD detection rounds (≥ 1 per pass)
+    long long broadPhases = 0;    // candidate gatherings (≥ 1 per pass)
+    long long candidates = 0;     // candidate pairs they found, summed
+    long long failSafeRuns = 0;   // passes that needed impact zones
+    long long zoneVertices = 0;   // vertices moved rigidly by impact zones, summed
+    long long frozenVertices = 0; // vertices held at x₀ by the last resort
+    long long unresolved = 0;     // hits left after every stage (a guarantee breach; reported)
+    long long halvings = 0;       // substeps the World halved because a pass stretched cloth
+    // Pairs skipped because they start touching or crossing (the most in one pass).
+    long long startTouching = 0;
+    double broadSeconds = 0.0, proximitySeconds = 0.0, ccdSeconds = 0.0, failSafeSeconds = 0.0;
+    void add(const SelfCollisionStats& o);
+};
+
+struct SelfCollisionSettings {
+    // CCD runs at this fraction of the thickness: proximity keeps pairs near ξ at the end of a
+    // step, CCD keeps the path between from closing to below ccdFraction·ξ.
+    double ccdFraction = 0.5;
+    int proximityIterations = 3; // Gauss–Seidel sweeps over the proximity pairs
+    int ccdRounds = 6;           // CCD detect-and-correct rounds before the impact zones
+    int zoneRounds = 64;         // impact-zone rounds before the last resort (hold at x₀)
+};
+
+class SelfCollision {
+public:
+    explicit SelfCollision(SelfCollisionSettings settings = {}) : mSettings(settings) {}
+
+    // A colliding body: its triangles (vertex indices of the body), rest positions (3 per
+    // vertex: pairs closer than the thickness at rest are never repelled), thickness ξ (m).
+    void addBody(Body& body, const std::vector<std::array<int, 3>>& triangles,
+                 const VecX& restPositions, double thickness);
+    size_t bodyCount() const { return mBodies.size(); }
+    size_t vertexCount() const { return mX0.size() / 3; }
+
+    // Resolves the substep that took each body from `start[b]` to its current positions:
+    // positions and velocities of the bodies are corrected in place. Returns this pass's counts.
+    // Precondition for the guarantee: the start positions have no crossings (pairs that start
+    // touching or crossing are left as they are and counted in startTouching).
+    SelfCollisionStats resolve(const std::vector<VecX>& start);
+
+    // Intersecting triangle pairs at the bodies' current positions (contact/intersect.h): per
+    // body, the pairs with at least one triangle of it.
+    std::vector<int> intersectionsPerBody() const;
+    // All pairs as (body, triangle) × 2.
+    std::vector<std::pair<std::array<int, 2>, std::array<int, 2>>> intersections() const;
+    // The smallest distance (m) between vertex–triangle and edge–edge pairs not within ξ of
+    // each other at rest, searched up to `radius`; +inf when none is that close.
+    double minimumSeparation(double radius) const;
+
+    // A pair of primitives as four global vertices and signed weights α: the pair's relative
+    // position is Σ α_k x_k (vertex − triangle point, or point on one edge − point on the other).
+    struct Pair {
+        std::array<int, 4> v;
+        std::array<double, 4> a;
+    };
+
+private:
+    void gather();
+    void scatter();
+    void refitBoxes(bool swept, double inflate);
+    void gatherCandidates(std::vector<Pair>& vt, std::vector<Pair>& ee) const;
+    bool restClose(const Pair& p, bool vertexTriangle) const;
+    bool adjacent(int a, int b) const;
+    bool neighbours(const Pair& p, bool vertexTriangle) const;
+    double relativeMotionBound(const Pair& p, bool vertexTriangle) const;
+    int proximity();
+    // One CCD detection over the step (and, with `apply`, the corrections); `zone`: per vertex
+    // its rigid impact zone or −1 (pairs inside one zone are skipped).
+    // `dirty`: per vertex whether it moved since the last round (null: test every candidate).
+    int ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone = nullptr,
+                 const std::vector<uint8_t>* dirty = nullptr);
+    // The pass's candidate pairs (swept boxes inflated by ξ), gathered again only when some
+    // vertex has moved more than ξ/2 since.
+    bool ensureCandidates(); // true when it gathered them again
+    std::vector<uint8_t> dirtySince(const std::vector<double>& before) const;
+    bool rigidZone(const std::vector<int>& members) const;
+    void impactZones(std::vector<Pair>& hits);
+    void applyZone(const std::vector<int>& members);
+    double pairThickness(const Pair& p) const;
+
+    SelfCollisionSettings mSettings;
+    struct Member {
+        Body* body;
+        int offset; // first global vertex
+    };
+    std::vector<Member> mBodies;
+    std::vector<int> mVertexBody;
+    std::vector<std::array<int, 3>> mTris; // global vertices
+    std::vector<int> mTriBody;
+    std::vector<std::array<int, 2>> mEdges;
+    std::vector<int> mAdjacencyStart, mAdjacency; // vertex neighbours by edges (CSR)
+    std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
+    contact::Bvh mVertTree, mTriTree, mEdgeTree;
+    std::vector<Pair> mCandVt, mCandEe;
+    std::vector<double> mXc; // x₁ when the candidates were gathered
+    bool mCandidatesValid = false;
+    // Per candidate (vertex–triangle, edge–edge): CCD cannot rule it out from the proximity
+    // pass's distances (the first CCD round tests these and pairs with moved vertices).
+    std::vector<uint8_t> mMaybe[2];
+    bool mMaybeValid = false;
+    std::vector<Pair> mLastHits; // of the last CCD round
+    std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
+    bool mBuilt = false;
+    long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild
+    double mMaxThickness = 0.0;
+    SelfCollisionStats mStats; // of the pass under way
+};
+
+} // namespace gale::solver

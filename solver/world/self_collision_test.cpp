@@ -1,0 +1,331 @@
+// Self- and cloth–cloth collision: the issue's falling sheet (which intersects itself without
+// it), a sheet thrown at another at one substep per frame (the tunnelling case), energy with no
+// wind, the impact-zone fail-safe on its own (momentum, no distance shrinking, no crossing on
+// the corrected path), results that do not depend on the threads, and a start that already
+// intersects (reported, kept from getting worse).
+#include "solver/world/self_collision.h"
+
+#include "solver/bodies/cloth.h"
+#include "solver/contact/ccd.h"
+#include "solver/contact/intersect.h"
+#include "solver/world/test_support.h"
+#include "solver/world/world.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace gale::solver;
+using namespace gale::solver::testing;
+
+namespace {
+
+// Intersecting triangle pairs over several bodies together (within and between them).
+size_t intersections(const std::vector<const Body*>& bodies) {
+    std::vector<double> x;
+    std::vector<std::array<int, 3>> tris;
+    for (const Body* b : bodies) {
+        const int offset = static_cast<int>(x.size() / 3);
+        x.insert(x.end(), b->positions().data(), b->positions().data() + b->positions().size());
+        for (const auto& t : *b->collisionTriangles())
+            tris.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+    return contact::intersectingPairs(x, tris).size();
+}
+
+Collider ground() {
+    Collider c;
+    c.shape = ColliderShape::Plane;
+    c.thickness = 0.005;
+    return c;
+}
+
+// The issue's case: a 0.8 m sheet (24 × 24) dropped edge-first onto the ground in a light
+// breeze, 4 substeps per frame, 48 frames. Returns the frames with intersecting pairs.
+int fallingSheet(bool selfCollision, int threads, VecX* final = nullptr) {
+    WorldSettings ws;
+    ws.threads = threads;
+    World w(ws);
+    w.setWind(constantWind(Vec3(0.5, 0.0, 0.3)));
+    w.addCollider(ground());
+    ClothMaterial m;
+    m.bend = gale::fields::Param(1e-4);
+    auto sheet =
+        std::make_unique<Cloth>("sheet", makeGrid(0.8, 0.8, 24, 24, Vec3(-0.4, 0.3, 0.0)), m);
+    sheet->collision().self = selfCollision;
+    w.addBody(std::move(sheet));
+    int frames = 0;
+    for (int f = 2; f <= 49; ++f) {
+        const FrameStats fs = w.advanceFrame(f);
+        REQUIRE_FALSE(fs.failed);
+        const size_t pairs = intersections({w.bodies()[0].get()});
+        if (selfCollision) {
+            CHECK(fs.selfContacts.unresolved == 0);
+            CHECK(fs.bodies[0].selfIntersections == static_cast<int>(pairs));
+        }
+        frames += pairs > 0;
+    }
+    if (final) *final = w.bodies()[0]->positions();
+    return frames;
+}
+
+// Is x above the (sagging, unfolded) sheet: the sheet's height under x's (x, z) by the triangle
+// whose projection holds it. Returns false when no triangle is under it.
+bool aboveSheet(const Body& sheet, const Vec3& x, bool& under) {
+    const auto& tris = *sheet.collisionTriangles();
+    const VecX& p = sheet.positions();
+    for (const auto& t : tris) {
+        const Vec3 a = vec3At(p.data(), t[0]), b = vec3At(p.data(), t[1]),
+                   c = vec3At(p.data(), t[2]);
+        const double det = (b.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (b.z() - a.z());
+        if (std::abs(det) < 1e-14) continue;
+        const double u =
+            ((x.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (x.z() - a.z())) / det;
+        const double v =
+            ((b.x() - a.x()) * (x.z() - a.z()) - (x.x() - a.x()) * (b.z() - a.z())) / det;
+        if (u < 0 || v < 0 || u + v > 1) continue;
+        under = true;
+        return x.y() > a.y() + u * (b.y() - a.y()) + v * (c.y() - a.y());
+    }
+    under = false;
+    return true;
+}
+
+struct TwoSheets {
+    std::unique_ptr<World> world;
+    Body* net = nullptr;
+    Body* falling = nullptr;
+};
+
+// A 0.6 m net pinned along its border at y = 0.5 and a 0.4 m sheet above it thrown down at
+// `speed`, one substep per frame when `substeps` is 1.
+TwoSheets twoSheets(double speed, int substeps, bool selfCollision, double thickness = 0.003) {
+    WorldSettings ws;
+    ws.substeps = substeps;
+    TwoSheets s;
+    s.world = std::make_unique<World>(ws);
+    ClothMaterial m;
+    m.lift.value = gale::fields::Param(0.0);
+    m.drag.value = gale::fields::Param(0.0);
+    auto net = std::make_unique<Cloth>(
+        "net", makeGrid(0.6, 0.6, 20, 20, Vec3(-0.3, 0.5, -0.3), Vec3::UnitX(), Vec3::UnitZ()), m);
+    PinSet border;
+    for (int j = 0; j < 20; ++j)
+        for (int i = 0; i < 20; ++i)
+            if (i == 0 || j == 0 || i == 19 || j == 19) border.vertices.push_back(j * 20 + i);
+    net->addPins(border);
+    auto top = std::make_unique<Cloth>(
+        "sheet", makeGrid(0.4, 0.4, 16, 16, Vec3(-0.18, 0.7, -0.22), Vec3::UnitX(), Vec3::UnitZ()),
+        m);
+    top->setVelocities(VecX(Eigen::RowVector3d(0.0, -speed, 0.0).replicate(1, 256).transpose()));
+    for (Body* b : {static_cast<Body*>(net.get()), static_cast<Body*>(top.get())}) {
+        b->collision().self = selfCollision;
+        b->collision().thickness = thickness;
+    }
+    s.net = net.get();
+    s.falling = top.get();
+    s.world->addBody(std::move(net));
+    s.world->addBody(std::move(top));
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("self-collision: the sheet falling edge-first onto the ground never intersects itself",
+          "[solver][self]") {
+    const int without = fallingSheet(false, 0);
+    CHECK(without > 20); // the case the issue measured: it does intersect without
+    CHECK(fallingSheet(true, 0) == 0);
+}
+
+TEST_CASE("self-collision: results do not depend on the threads", "[solver][self]") {
+    VecX one, two;
+    fallingSheet(true, 1, &one);
+    fallingSheet(true, 2, &two);
+    CHECK((one - two).cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("self-collision: a sheet thrown at a net at one substep per frame stays on its side",
+          "[solver][self]") {
+    // 5 m/s at 1/24 s: 0.2 m per substep, 67 × the thickness.
+    for (bool on : {false, true}) {
+        TwoSheets s = twoSheets(5.0, 1, on);
+        int below = 0, pairsFrames = 0;
+        double minSep = INFINITY;
+        for (int f = 2; f <= 24; ++f) {
+            const FrameStats fs = s.world->advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            pairsFrames += intersections({s.net, s.falling}) > 0;
+            for (size_t i = 0; i < s.falling->vertexCount(); ++i) {
+                bool under = false;
+                if (!aboveSheet(*s.net, vec3At(s.falling->positions().data(), i), under) && under)
+                    ++below;
+            }
+            if (on) {
+                CHECK(fs.selfContacts.unresolved == 0);
+                minSep = std::min(minSep, s.world->selfCollision()->minimumSeparation(0.01));
+            }
+        }
+        if (on) {
+            CHECK(pairsFrames == 0);
+            CHECK(below == 0);
+            // Proximity keeps ξ at the end of a step, CCD ξ/2 on the way: stated bound ξ/4.
+            CHECK(minSep > 0.25 * 0.003);
+        } else {
+            CHECK(below > 0); // without contact the sheet falls through the net
+        }
+    }
+}
+
+TEST_CASE("self-collision: no energy from contact with no wind", "[solver][self]") {
+    // Two free sheets in zero gravity and still air meet at 1 m/s each (one substep moves them
+    // 2 cm closer, 7 × the thickness): the contact is inelastic, so kinetic + elastic energy
+    // never rises above the start (1 % for the solver's own rounding of elastic energy).
+    for (int substeps : {1, 4}) {
+        WorldSettings ws;
+        ws.gravity = Vec3::Zero();
+        ws.substeps = substeps;
+        World w(ws);
+        ClothMaterial m;
+        m.lift.value = gale::fields::Param(0.0);
+        m.drag.value = gale::fields::Param(0.0);
+        auto a = std::make_unique<Cloth>(
+            "a", makeGrid(0.4, 0.4, 16, 16, Vec3(-0.2, 0.45, -0.2), Vec3::UnitX(), Vec3::UnitZ()),
+            m);
+        auto b = std::make_unique<Cloth>(
+            "b", makeGrid(0.3, 0.3, 13, 13, Vec3(-0.12, 0.55, -0.17), Vec3::UnitX(), Vec3::UnitZ()),
+            m);
+        a->setVelocities(VecX(Eigen::RowVector3d(0.0, 1.0, 0.0).replicate(1, 256).transpose()));
+        b->setVelocities(VecX(Eigen::RowVector3d(0.0, -1.0, 0.0).replicate(1, 169).transpose()));
+        a->collision().self = b->collision().self = true;
+        w.addBody(std::move(a));
+        w.addBody(std::move(b));
+        double e0 = 0.0;
+        for (const auto& body : w.bodies()) e0 += body->kineticEnergy() + body->elasticEnergy(0.0);
+        double worst = 0.0;
+        long long hits = 0;
+        for (int f = 2; f <= 24; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            double e = 0.0;
+            for (const auto& body : fs.bodies) e += body.kinetic + body.elastic;
+            worst = std::max(worst, e);
+            hits += fs.selfContacts.ccdHits + fs.selfContacts.proximityPairs;
+            CHECK(fs.selfContacts.unresolved == 0);
+        }
+        CAPTURE(substeps, e0, worst);
+        CHECK(hits > 0);
+        CHECK(worst <= 1.01 * e0);
+    }
+}
+
+TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self]") {
+    // Two single triangles; the upper one's step goes straight through the lower one. With no
+    // CCD rounds the pass goes to the impact zones at once.
+    TriMesh lower, upper;
+    lower.positions = {0, 0, 0, 1, 0, 0, 0, 0, 1};
+    lower.triangles = {{0, 1, 2}};
+    upper.positions = {0.2, 0.1, 0.2, 0.6, 0.1, 0.2, 0.2, 0.1, 0.6};
+    upper.triangles = {{0, 1, 2}};
+    ClothMaterial m;
+    Cloth a("lower", lower, m), b("upper", upper, m);
+    VecX ma(3), mb(3);
+    ma << 1.0, 2.0, 3.0;
+    mb << 1.5, 1.0, 0.5;
+    a.setMasses(ma);
+    b.setMasses(mb);
+    const VecX a0 = a.positions(), b0 = b.positions();
+    VecX a1 = a0, b1 = b0;
+    for (int i = 0; i < 3; ++i) {
+        a1[3 * i + 1] += 0.05;           // the lower one rises
+        b1[3 * i + 1] -= 0.3 + 0.05 * i; // the upper one falls through it, tilting
+        b1[3 * i] += 0.02 * i;
+    }
+    a.setPositions(a1);
+    b.setPositions(b1);
+    a.setVelocities(24.0 * (a1 - a0));
+    b.setVelocities(24.0 * (b1 - b0));
+    const auto momentum = [&](const VecX& da, const VecX& db) {
+        Vec3 p = Vec3::Zero();
+        for (int i = 0; i < 3; ++i)
+            p += ma[i] * Vec3(da.segment<3>(3 * i)) + mb[i] * Vec3(db.segment<3>(3 * i));
+        return p;
+    };
+    const Vec3 before = momentum(a1 - a0, b1 - b0);
+    SelfCollisionSettings settings;
+    settings.ccdRounds = 0;
+    SelfCollision sc(settings);
+    sc.addBody(a, lower.triangles, a0, 0.003);
+    sc.addBody(b, upper.triangles, b0, 0.003);
+    const SelfCollisionStats st = sc.resolve({a0, b0});
+    CHECK(st.failSafeRuns == 1);
+    CHECK(st.unresolved == 0);
+    CHECK(st.frozenVertices == 0);
+    const VecX& A1 = a.positions();
+    const VecX& B1 = b.positions();
+    // Momentum of the displacements kept (one zone holding all six vertices).
+    CHECK((momentum(A1 - a0, B1 - b0) - before).norm() < 1e-12);
+    // No distance between any two of the six vertices shrank: the zone's map is I + [ω]×.
+    std::vector<Vec3> x0, x1;
+    for (int i = 0; i < 3; ++i) {
+        x0.push_back(a0.segment<3>(3 * i));
+        x0.push_back(b0.segment<3>(3 * i));
+        x1.push_back(A1.segment<3>(3 * i));
+        x1.push_back(B1.segment<3>(3 * i));
+    }
+    for (size_t i = 0; i < 6; ++i)
+        for (size_t j = i + 1; j < 6; ++j)
+            CHECK((x1[i] - x1[j]).norm() >= (x0[i] - x0[j]).norm() * (1.0 - 1e-12));
+    // And the corrected path crosses nothing: CCD with zero thickness finds no contact.
+    contact::CcdOptions opt;
+    double toi = 0.0;
+    for (int v = 0; v < 3; ++v) {
+        const Vec3 p0 = b0.segment<3>(3 * v), p1 = B1.segment<3>(3 * v);
+        CHECK_FALSE(
+            contact::vertexTriangleCcd(p0, p1, x0[0], x1[0], x0[2], x1[2], x0[4], x1[4], opt, toi));
+    }
+    // The ordinary path (CCD rounds) resolves the same step without the fail-safe.
+    a.setPositions(a1);
+    b.setPositions(b1);
+    SelfCollision normal;
+    normal.addBody(a, lower.triangles, a0, 0.003);
+    normal.addBody(b, upper.triangles, b0, 0.003);
+    const SelfCollisionStats st2 = normal.resolve({a0, b0});
+    CHECK(st2.ccdHits > 0);
+    CHECK(st2.unresolved == 0);
+    CHECK(normal.intersections().empty());
+    CHECK(normal.minimumSeparation(0.5) > 0.25 * 0.003);
+}
+
+TEST_CASE("self-collision: a start that intersects is reported and not made worse",
+          "[solver][self]") {
+    // A vertical sheet through a horizontal one, both free, falling onto the ground.
+    World w(WorldSettings{});
+    w.addCollider(ground());
+    ClothMaterial m;
+    auto flat = std::make_unique<Cloth>(
+        "flat", makeGrid(0.5, 0.5, 12, 12, Vec3(-0.25, 0.2, -0.25), Vec3::UnitX(), Vec3::UnitZ()),
+        m);
+    auto wall =
+        std::make_unique<Cloth>("wall", makeGrid(0.3, 0.3, 10, 10, Vec3(-0.15, 0.05, 0.013)), m);
+    flat->collision().self = wall->collision().self = true;
+    w.addBody(std::move(flat));
+    w.addBody(std::move(wall));
+    const auto startPairs = [&] {
+        return intersections({w.bodies()[0].get(), w.bodies()[1].get()});
+    };
+    const size_t at0 = startPairs();
+    REQUIRE(at0 > 0);
+    const FrameStats first = w.advanceFrame(2);
+    bool reported = false;
+    for (const auto& e : first.bodies[0].events)
+        reported = reported || e.find("intersecting") != std::string::npos;
+    CHECK(reported);
+    size_t worst = 0;
+    for (int f = 3; f <= 24; ++f) {
+        const FrameStats fs = w.advanceFrame(f);
+        REQUIRE_FALSE(fs.failed);
+        worst = std::max(worst, startPairs());
+    }
+    CHECK(worst <= at0);
+}

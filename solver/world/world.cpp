@@ -1,0 +1,387 @@
+// Frame stepping with substep halving (as production cloth solvers do on trouble), per-frame
+// statistics, and the binary state used by `gale sim --resume`.
+#include "solver/world/world.h"
+
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+namespace gale::solver {
+
+namespace {
+// Newton iterations of the retry of a substep in trouble (World::advanceBody).
+constexpr int kRetryNewtonIterations = 16;
+// A self-collision pass that leaves an edge longer than kPassStretch × its rest length and
+// kPassStretchGrowth × what the solve left has its interval redone at half the step.
+constexpr double kPassStretch = 1.1;
+constexpr double kPassStretchGrowth = 1.05;
+} // namespace
+
+struct World::Arena {
+    tbb::task_arena arena;
+    explicit Arena(int threads) : arena(threads) {}
+};
+
+World::World(WorldSettings settings) : mSettings(std::move(settings)) {
+    int threads = mSettings.threads;
+    if (threads <= 0) threads = tbb::info::default_concurrency();
+    mSettings.threads = threads;
+    mArena = std::make_unique<Arena>(threads);
+}
+
+World::~World() = default;
+
+FrameStats World::advanceFrame(int frame) {
+    FrameStats fs = advance((frame - 1) / mSettings.fps, 1.0 / mSettings.fps, mSettings.substeps);
+    fs.frame = frame;
+    return fs;
+}
+
+FrameStats World::advance(double t0, double dt, int substeps) {
+    FrameStats fs;
+    fs.time = t0 + dt;
+    const auto start = std::chrono::steady_clock::now();
+    fs.bodies.resize(mBodies.size());
+    substeps = std::max(substeps, 1);
+    mArena->arena.execute([&] {
+        if (!mSelfSetUp) setUpSelfCollision(fs);
+        if (mSelf) advanceColliding(t0, dt, substeps, fs);
+        for (size_t b = 0; b < mBodies.size(); ++b) {
+            if (mSelf && std::find(mSelfBodies.begin(), mSelfBodies.end(), b) != mSelfBodies.end())
+                continue;
+            advanceBody(*mBodies[b], t0, dt, substeps, fs.bodies[b]);
+        }
+        for (const BodyFrameStats& b : fs.bodies) fs.failed = fs.failed || b.failed;
+    });
+    fs.wallSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return fs;
+}
+
+void World::setUpSelfCollision(FrameStats& fs) {
+    mSelfSetUp = true;
+    auto self = std::make_unique<SelfCollision>();
+    for (size_t b = 0; b < mBodies.size(); ++b) {
+        Body& body = *mBodies[b];
+        const auto* tris = body.collisionTriangles();
+        if (!body.collision().self || !tris) continue;
+        self->addBody(body, *tris, body.restPositions(), body.collision().thickness);
+        mSelfBodies.push_back(b);
+    }
+    if (mSelfBodies.empty()) return;
+    mSelf = std::move(self);
+    // A start that already intersects cannot be untangled; the passes keep it from worsening.
+    const std::vector<int> start = mSelf->intersectionsPerBody();
+    char buf[256];
+    for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+        if (start[k] == 0) continue;
+        std::snprintf(buf, sizeof buf,
+                      "self-collision: the start shape has %d intersecting triangle pair(s); "
+                      "they are kept from getting worse but not undone (untangle the mesh to "
+                      "remove them)",
+                      start[k]);
+        fs.bodies[mSelfBodies[k]].events.push_back(buf);
+    }
+}
+
+// The colliding bodies advance in lockstep, one base substep at a time (each with its own
+// halving inside it), then one self-collision pass over the straight path from the substep's
+// start to its end (self_collision.h): the end state has no crossing the start did not have.
+void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs) {
+    fs.selfCollision = true;
+    const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
+    const long ticksPerBase = 1L << maxLevel;
+    const long totalTicks = ticksPerBase * substeps;
+    const size_t n = mSelfBodies.size();
+    std::vector<BodyRun> runs(n);
+    std::vector<VecX> starts(n);
+    std::vector<Body::Snapshot> snaps(n);
+    std::vector<double> stretchBefore(n);
+    char buf[320];
+    // Collisions resolved at the end of a substep move positions without the implicit solve
+    // seeing it: a fast impact at a long substep then stretches cloth (stored energy the contact
+    // never had). When a pass stretches an edge beyond both kPassStretch and kPassStretchGrowth
+    // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
+    // step, as the solver halves a substep in trouble; the level holds for the rest of the frame.
+    int level = 0;
+    long tick = 0;
+    while (tick < totalTicks) {
+        const long end = std::min(totalTicks, tick + (ticksPerBase >> level));
+        std::vector<BodyRun> runsBefore = runs;
+        for (size_t k = 0; k < n; ++k) {
+            Body& body = *mBodies[mSelfBodies[k]];
+            snaps[k] = body.snapshot();
+            starts[k] = body.positions();
+            runs[k].level = std::max(runs[k].level, level);
+            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]]);
+            stretchBefore[k] = body.maxEdgeStretch();
+        }
+        const SelfCollisionStats st = mSelf->resolve(starts);
+        fs.selfContacts.add(st);
+        const double tEnd = t0 + dt * static_cast<double>(end) / static_cast<double>(totalTicks);
+        bool stretched = false;
+        double worst = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            Body& body = *mBodies[mSelfBodies[k]];
+            const double after = body.maxEdgeStretch();
+            worst = std::max(worst, after);
+            if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
+                after > body.limits().overStretch)
+                stretched = true;
+        }
+        if (stretched && level < maxLevel) {
+            for (size_t k = 0; k < n; ++k) {
+                mBodies[mSelfBodies[k]]->restore(snaps[k]);
+                BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
+                ++stats.rejected;
+                stats.deepestHalving = std::max(stats.deepestHalving, level + 1);
+            }
+            runs = runsBefore;
+            ++level;
+            ++fs.selfContacts.halvings;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision stretched cloth to %.3g × its rest length; "
+                          "substep halved to %.6g s",
+                          tEnd, worst, dt / substeps / static_cast<double>(1L << level));
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+            continue;
+        }
+        if (st.unresolved > 0) {
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision left %lld pair(s) unresolved after the "
+                          "fail-safe (pins or attachments moving apart inside an impact zone)",
+                          tEnd, st.unresolved);
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+        }
+        tick = end;
+    }
+    const std::vector<int> pairs = mSelf->intersectionsPerBody();
+    for (size_t k = 0; k < mSelfBodies.size(); ++k) {
+        BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
+        finishBodyStats(*mBodies[mSelfBodies[k]], t0 + dt, stats);
+        stats.selfIntersections = pairs[k];
+    }
+}
+
+void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats) {
+    BodyRun run;
+    const long ticksPerBase = 1L << std::clamp(mSettings.maxHalvings, 0, 20);
+    stepBody(body, t0, dt, substeps, ticksPerBase * substeps, run, stats);
+    finishBodyStats(body, t0 + dt, stats);
+}
+
+void World::stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
+                     BodyFrameStats& stats) {
+    stats.name = body.name();
+    const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
+    const long ticksPerBase = 1L << maxLevel;
+    const double hBase = dt / substeps;
+    Environment env;
+    env.wind = mWind.get();
+    env.airDensity = mSettings.airDensity;
+    env.gravity = mSettings.gravity;
+    env.colliders = &mColliders;
+    env.fps = mSettings.fps;
+    env.threads = mSettings.threads;
+    long& tick = run.tick;
+    int& level = run.level;
+    int& index = run.index;
+    char buf[512];
+    while (tick < untilTick && !run.stopped) {
+        const double h = hBase / static_cast<double>(1L << level);
+        const double t =
+            t0 + hBase * (static_cast<double>(tick) / static_cast<double>(ticksPerBase));
+        env.substepIndex = index;
+        const Body::Snapshot snap = body.snapshot();
+        SubstepStatus st = body.substep(env, t, h);
+        // Over-stretch or a velocity jump from the linearised step: first the same substep again
+        // with Newton's line search (which cuts a step that over-stretches), then halving.
+        const int newton = body.options().newtonIterations;
+        if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
+            newton < kRetryNewtonIterations && !mSettings.noNewtonRetry) {
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
+                          troubleName(st.trouble), st.reason.c_str(), kRetryNewtonIterations);
+            body.restore(snap);
+            // The retry wants the line search's cut of an over-stretching step, not convergence:
+            // the SPD linearisation of each iterate (no GMRES on the full Jacobian).
+            const bool full = body.options().newtonFullJacobian;
+            body.options().newtonIterations = kRetryNewtonIterations;
+            body.options().newtonFullJacobian = false;
+            const int firstIterations = st.iterations;
+            st = body.substep(env, t, h);
+            body.options().newtonIterations = newton;
+            body.options().newtonFullJacobian = full;
+            st.iterations += firstIterations;
+            ++stats.newtonRetries;
+            stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None
+                                                           ? ": accepted"
+                                                           : ": still in trouble"));
+        }
+        stats.iterations += st.iterations;
+        stats.maxIterations = std::max(stats.maxIterations, st.iterations);
+        stats.maxResidual = std::max(stats.maxResidual, st.residual);
+        stats.clampedJacobians += st.clampedJacobians;
+        stats.newtonIterations += st.newtonIterations;
+        stats.maxNewtonIterations = std::max(stats.maxNewtonIterations, st.newtonIterations);
+        stats.lineSearchCuts += st.lineSearchCuts;
+        stats.maxNewtonResidual = std::max(stats.maxNewtonResidual, st.newtonResidual);
+        if (st.newtonStalled) ++stats.newtonStalled;
+        if (st.windNonFinite) {
+            if (stats.windNonFinite == 0) {
+                std::snprintf(buf, sizeof buf, "t=%.6g s: wind: %s", t, st.windMessage.c_str());
+                stats.events.push_back(buf);
+            }
+            stats.windNonFinite += st.windNonFinite;
+        }
+        if (st.trouble != Trouble::None) {
+            if (level < maxLevel) {
+                body.restore(snap);
+                ++level;
+                ++stats.rejected;
+                stats.deepestHalving = std::max(stats.deepestHalving, level);
+                std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep halved to %.6g s", t,
+                              troubleName(st.trouble), st.reason.c_str(), hBase / (1L << level));
+                stats.events.push_back(buf);
+                continue;
+            }
+            // At the smallest substep: recover (speeds capped, strain limited) rather
+            // than give up; the state stays finite and bounded.
+            const int fixes = body.recover(snap, h);
+            ++stats.recovered;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s) at the smallest substep %.6g s; recovered by strain "
+                          "limiting (%d edge correction(s)) and a speed cap",
+                          t, troubleName(st.trouble), st.reason.c_str(), h, fixes);
+            stats.events.push_back(buf);
+            if (!body.positions().allFinite() || !body.velocities().allFinite()) {
+                body.restore(snap);
+                stats.failed = true;
+                stats.events.push_back("run failed: the recovered state is not finite");
+                run.stopped = true;
+                break;
+            }
+        }
+        tick += ticksPerBase >> level;
+        stats.contacts = st.contacts;
+        ++stats.substeps;
+        ++index;
+    }
+}
+
+void World::finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const {
+    stats.maxSpeed = 0.0;
+    const VecX& v = body.velocities();
+    for (size_t i = 0; i < body.vertexCount(); ++i)
+        stats.maxSpeed = std::max(stats.maxSpeed, vec3At(v.data(), i).norm());
+    stats.maxStretch = body.maxEdgeStretch();
+    stats.kinetic = body.kineticEnergy();
+    stats.potential = body.potentialEnergy(mSettings.gravity);
+    stats.elastic = body.elasticEnergy(t1);
+}
+
+// ---- state bytes: "GALESTATE" v1, then per body: name, vertex count, x, v, Δv guess, h guess.
+
+namespace {
+void putU64(std::string& s, uint64_t v) {
+    s.append(reinterpret_cast<const char*>(&v), 8);
+}
+void putVec(std::string& s, const VecX& v) {
+    putU64(s, static_cast<uint64_t>(v.size()));
+    if (v.size() > 0) s.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
+}
+struct Reader {
+    const std::string& s;
+    size_t pos = 0;
+    bool ok = true;
+    uint64_t u64() {
+        uint64_t v = 0;
+        if (pos + 8 > s.size()) {
+            ok = false;
+            return 0;
+        }
+        std::memcpy(&v, s.data() + pos, 8);
+        pos += 8;
+        return v;
+    }
+    VecX vec() {
+        const uint64_t n = u64();
+        if (!ok || n > (s.size() - pos) / sizeof(double)) {
+            ok = false;
+            return VecX();
+        }
+        VecX v(static_cast<long>(n));
+        if (n > 0)
+            std::memcpy(v.data(), s.data() + pos, sizeof(double) * n); // data() is null when empty
+        pos += sizeof(double) * n;
+        return v;
+    }
+};
+} // namespace
+
+std::string World::saveState() const {
+    std::string s = "GALESTATE1";
+    putU64(s, mBodies.size());
+    for (const auto& b : mBodies) {
+        putU64(s, b->name().size());
+        s += b->name();
+        const Body::Snapshot snap = b->snapshot();
+        putVec(s, snap.x);
+        putVec(s, snap.v);
+        putVec(s, snap.dvGuess);
+        double h = snap.hGuess;
+        s.append(reinterpret_cast<const char*>(&h), sizeof h);
+    }
+    return s;
+}
+
+bool World::loadState(const std::string& bytes, std::string& error) {
+    if (bytes.compare(0, 10, "GALESTATE1") != 0) {
+        error = "not a gale solver state (bad header)";
+        return false;
+    }
+    Reader r{bytes, 10};
+    const uint64_t count = r.u64();
+    if (!r.ok || count != mBodies.size()) {
+        error = "the state holds a different number of objects than the scene";
+        return false;
+    }
+    std::vector<Body::Snapshot> snaps(count);
+    for (uint64_t i = 0; i < count; ++i) {
+        const uint64_t len = r.u64();
+        if (!r.ok || r.pos + len > bytes.size()) {
+            error = "truncated state";
+            return false;
+        }
+        const std::string name = bytes.substr(r.pos, len);
+        r.pos += len;
+        if (name != mBodies[i]->name()) {
+            error = "the state's object '" + name + "' does not match the scene's '" +
+                    mBodies[i]->name() + "'";
+            return false;
+        }
+        snaps[i].x = r.vec();
+        snaps[i].v = r.vec();
+        snaps[i].dvGuess = r.vec();
+        if (r.pos + sizeof(double) > bytes.size()) r.ok = false;
+        if (r.ok) {
+            std::memcpy(&snaps[i].hGuess, bytes.data() + r.pos, sizeof(double));
+            r.pos += sizeof(double);
+        }
+        const long n3 = static_cast<long>(3 * mBodies[i]->vertexCount());
+        if (!r.ok || snaps[i].x.size() != n3 || snaps[i].v.size() != n3) {
+            error = "the state of '" + name + "' does not match its vertex count";
+            return false;
+        }
+    }
+    for (uint64_t i = 0; i < count; ++i) mBodies[i]->restore(snaps[i]);
+    return true;
+}
+
+} // namespace gale::solver

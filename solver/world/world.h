@@ -1,0 +1,122 @@
+// A simulation: bodies, colliders and the summed wind, advanced frame by frame with robust
+// substepping — a substep in trouble (non-finite state, the linear solver not converging,
+// over-stretch, a velocity jump) is undone and retried at half the step, the reason logged.
+#pragma once
+
+#include "fields/field.h"
+#include "solver/bodies/body.h"
+#include "solver/collider/collider.h"
+#include "solver/world/self_collision.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gale::solver {
+
+struct WorldSettings {
+    double fps = 24.0;
+    int substeps = 4;    // per frame, the minimum
+    int maxHalvings = 6; // a substep may be split down to 1/2⁶ of its size
+    Vec3 gravity = Vec3(0.0, -9.81, 0.0);
+    double airDensity = 1.225;  // kg/m³
+    int threads = 1;            // 0: all hardware threads; results do not depend on it
+    bool noNewtonRetry = false; // tests and benchmarks of the raw halving: no Newton retry
+};
+
+// Per body, per frame.
+struct BodyFrameStats {
+    std::string name;
+    int substeps = 0;       // accepted substeps
+    int rejected = 0;       // substeps undone and retried at half the step
+    int recovered = 0;      // substeps at the smallest size recovered by Body::recover
+    int newtonRetries = 0;  // substeps in trouble retried with Newton before halving
+    int deepestHalving = 0; // 0: every substep at the base size
+    long iterations = 0;    // linear-solver iterations, summed over substeps
+    int maxIterations = 0;  // the most in one substep
+    double maxResidual = 0.0;
+    int newtonIterations = 0;       // Newton corrections after the linearised solves, summed
+    int maxNewtonIterations = 0;    // the most in one substep
+    double maxNewtonResidual = 0.0; // m/s: the largest velocity residual a substep ended with
+    int lineSearchCuts = 0;         // Newton line-search halvings, summed
+    int newtonStalled = 0;          // substeps that ended above newton_tolerance
+    double maxSpeed = 0.0;          // m/s at the end of the frame
+    double maxStretch = 0.0;        // edge length / rest length at the end of the frame
+    double kinetic = 0.0, elastic = 0.0, potential = 0.0; // J, end of frame
+    size_t windNonFinite = 0;
+    int clampedJacobians = 0;
+    int contacts = 0; // vertices touching colliders at the end of the frame
+    // Intersecting triangle pairs with a triangle of this body at the end of the frame, counted
+    // when it takes part in cloth–cloth collision (−1: not counted).
+    int selfIntersections = -1;
+    std::vector<std::string> events; // substep halvings and recoveries, with reasons
+    bool failed = false;             // non-finite state that halving could not fix (state restored)
+};
+
+struct FrameStats {
+    int frame = 0;
+    double time = 0.0; // seconds at the end of the frame
+    double wallSeconds = 0.0;
+    std::vector<BodyFrameStats> bodies;
+    bool failed = false;
+    bool selfCollision = false;      // some bodies collide with themselves and each other
+    SelfCollisionStats selfContacts; // ... their passes over the frame
+};
+
+class World {
+public:
+    explicit World(WorldSettings settings);
+    ~World();
+
+    const WorldSettings& settings() const { return mSettings; }
+    void setWind(fields::FieldPtr wind) { mWind = std::move(wind); }
+    const fields::FieldPtr& wind() const { return mWind; }
+    void addBody(std::unique_ptr<Body> body) { mBodies.push_back(std::move(body)); }
+    void addCollider(Collider c) { mColliders.push_back(std::move(c)); }
+    const std::vector<std::unique_ptr<Body>>& bodies() const { return mBodies; }
+    Body& body(size_t i) { return *mBodies[i]; }
+    const std::vector<Collider>& colliders() const { return mColliders; }
+
+    // Advances every body from frame − 1 to `frame` (times (frame − 1)/fps → frame/fps).
+    FrameStats advanceFrame(int frame);
+    // Advances by one interval [t0, t0 + dt] split into `substeps` base substeps.
+    FrameStats advance(double t0, double dt, int substeps);
+
+    // The complete state (positions, velocities, warm starts) as bytes, and back: a run
+    // resumed from it continues bit for bit. Returns false with `error` on a mismatch.
+    std::string saveState() const;
+    bool loadState(const std::string& bytes, std::string& error);
+
+    // Cloth–cloth collision of the bodies with collision().self (null when none has it); set
+    // up on the first advance.
+    const SelfCollision* selfCollision() const { return mSelf.get(); }
+
+private:
+    // Where a body's frame stepping stands: ticks of the finest substep done, halving level,
+    // substep index, stopped by a failure.
+    struct BodyRun {
+        long tick = 0;
+        int level = 0;
+        int index = 0;
+        bool stopped = false;
+    };
+    void advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats);
+    // Steps `body` until `run.tick` reaches `untilTick` (ticks: 2^maxHalvings per base substep).
+    void stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
+                  BodyFrameStats& stats);
+    void finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const;
+    void setUpSelfCollision(FrameStats& fs);
+    void advanceColliding(double t0, double dt, int substeps, FrameStats& fs);
+
+    WorldSettings mSettings;
+    fields::FieldPtr mWind;
+    std::vector<std::unique_ptr<Body>> mBodies;
+    std::vector<Collider> mColliders;
+    struct Arena;
+    std::unique_ptr<Arena> mArena;
+    std::unique_ptr<SelfCollision> mSelf;
+    std::vector<size_t> mSelfBodies; // indices of the bodies in mSelf, in its order
+    bool mSelfSetUp = false;
+};
+
+} // namespace gale::solver
