@@ -32,6 +32,12 @@ EventStreams::EventStreams(int pingMs, size_t maxUnsent) : mPingMs(pingMs), mMax
 
 EventStreams::~EventStreams() {
     stop();
+    // (Closed only here: publish() may still write to mWake from another thread after stop.)
+    for (int* fd : {&mEpoll, &mWake})
+        if (*fd >= 0) {
+            ::close(*fd);
+            *fd = -1;
+        }
 }
 
 bool EventStreams::start(std::string& error) {
@@ -88,11 +94,6 @@ void EventStreams::stop() {
     }
     mAdopted.clear();
     mCount = 0;
-    for (int* fd : {&mEpoll, &mWake})
-        if (*fd >= 0) {
-            ::close(*fd);
-            *fd = -1;
-        }
 }
 
 void EventStreams::drop(int fd) {

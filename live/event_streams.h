@@ -35,7 +35,7 @@ public:
     void adopt(int fd, uint64_t after);
     // Open streams (adopted and not yet dropped).
     size_t count() const { return mCount; }
-    // Closes every stream and ends the thread.
+    // Closes every stream and ends the thread (publish() stays harmless after it).
     void stop();
 
 private:

@@ -298,11 +298,16 @@ public:
         std::lock_guard<std::mutex> stopping(mStopMutex);
         if (mStopped) return;
         mStopped = true;
+        mSimulateOn = false;
         mEvents.stop();
-        mSim.stop();
-        if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
-            std::error_code ec;
-            fs::remove_all(mTempDir, ec);
+        {
+            std::lock_guard<std::mutex> simLock(mSimMutex);
+            mShuttingDown = true; // (a reload on the watcher's thread starts no new run now)
+            mSim.stop();
+            if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
+                std::error_code ec;
+                fs::remove_all(mTempDir, ec);
+            }
         }
         mWatcher.stop();
         mHttp.stop();
@@ -388,6 +393,8 @@ private:
             error = message;
             return false;
         };
+        if (mShuttingDown) return refuse(503, "the server is stopping");
+        if (restart && !mSimulateOn) return true; // (stopped since the edit was seen)
         if (mOpt.galeExecutable.empty())
             return refuse(409, "simulation is not available in this server");
         std::vector<SimObject> objects;
@@ -777,8 +784,8 @@ private:
         if (!bodyJson(req, res, body)) return;
         const std::string action = body.value("action", std::string("start"));
         if (action == "stop") {
-            mSimulateOn = false;
             std::lock_guard<std::mutex> simLock(mSimMutex);
+            mSimulateOn = false;
             mSim.stop();
         } else if (action == "start") {
             std::string error;
@@ -807,7 +814,8 @@ private:
     int mPort = 0;
     std::string mTempDir;
     int mRuns = 0;
-    std::mutex mSimMutex;                 // starting and stopping the simulation
+    std::mutex mSimMutex;                 // starting and stopping the simulation, mTempDir
+    bool mShuttingDown = false;           // (under mSimMutex) stop() has begun
     std::atomic<int> mRunId{0};           // the current run, in its events
     std::atomic<bool> mSimulateOn{false}; // Simulate pressed and not stopped: edits re-simulate
     std::mutex mStopMutex, mWaitMutex;

@@ -48,8 +48,11 @@ bool within(const std::string& dir, const std::string& prefix) {
             (prefix.back() == '/' || dir[prefix.size()] == '/'));
 }
 
+// A file counts once it is complete: closed after writing, or renamed into place (what
+// editors do), or gone; a file still being written (created, modified, not closed) does not
+// yet, so a reload never reads half a file. A folder counts when it is created.
 constexpr uint32_t kEvents = IN_CLOSE_WRITE | IN_MOVED_TO | IN_MOVED_FROM | IN_CREATE | IN_DELETE |
-                             IN_MODIFY | IN_DELETE_SELF | IN_MOVE_SELF;
+                             IN_DELETE_SELF | IN_MOVE_SELF;
 
 } // namespace
 
@@ -183,6 +186,8 @@ void FileWatcher::run() {
                     continue;
                 }
                 if (ev->len == 0) continue;
+                if ((ev->mask & IN_CREATE) && !(ev->mask & IN_ISDIR))
+                    continue; // (its close follows)
                 const std::string path =
                     (fs::path(dir->second) / ev->name).lexically_normal().string();
                 if (mFiles.count(path)) pending.insert(path);
