@@ -420,21 +420,30 @@ private:
             dir = mTempDir + "/sim" + std::to_string(mRuns + 1);
         }
         const std::string oldDir = mSim.outDir();
+        const std::vector<SimObject> oldObjects = mSim.objects();
+        const int oldRun = mRunId;
         mSim.stop(true); // (its exit event carries the old run's id)
         ++mRuns;
         mRunId = mRuns;
         if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
             return refuse(500, error);
-        // A replaced run's folder is thrown away (the page keeps what it drew, greyed).
-        if (restart && mOpt.simDir.empty() && !oldDir.empty() && oldDir != dir) {
-            std::error_code ec;
-            fs::remove_all(oldDir, ec);
+        // The run an edit replaced is kept to compare with (/api/frame?run=), the one it had
+        // replaced is thrown away.
+        if (restart && !oldDir.empty() && oldDir != dir) {
+            if (mOpt.simDir.empty() && !mPrevDir.empty() && mPrevDir != dir) {
+                std::error_code ec;
+                fs::remove_all(mPrevDir, ec);
+            }
+            mPrevDir = oldDir;
+            mPrevRun = oldRun;
+            mPrevObjects = oldObjects;
         }
         publish("sim", json{{"running", true},
                             {"dir", dir},
                             {"frames", {first, last}},
                             {"run", mRunId.load()},
                             {"restart", restart},
+                            {"previous", mPrevRun},
                             {"on", true}});
         return true;
     }
@@ -631,7 +640,20 @@ private:
         int n = 0;
         if (!intParam(req, "n", -1, -1000000, 1000000, n))
             return fail(res, 400, "n: a frame number");
-        const std::string dir = mSim.outDir();
+        int want = 0;
+        if (!intParam(req, "run", 0, 0, 1 << 30, want)) return fail(res, 400, "run: a run number");
+        std::string dir;
+        std::vector<SimObject> simObjects;
+        int run;
+        {
+            std::lock_guard<std::mutex> simLock(mSimMutex);
+            const bool previous = want > 0 && want == mPrevRun;
+            if (want > 0 && !previous && want != mRunId)
+                return fail(res, 404, "run " + std::to_string(want) + " is gone (the current and the one it replaced are kept)");
+            dir = previous ? mPrevDir : mSim.outDir();
+            simObjects = previous ? mPrevObjects : mSim.objects();
+            run = previous ? mPrevRun : mRunId.load();
+        }
         if (dir.empty()) return fail(res, 404, "no simulation yet: POST /api/simulate");
         std::vector<viz::GeometryOverlay> rest;
         {
@@ -639,7 +661,7 @@ private:
             rest = mProject.restGeometry();
         }
         json objects = json::array();
-        for (const SimObject& o : mSim.objects()) {
+        for (const SimObject& o : simObjects) {
             viz::GeometryOverlay g;
             std::string error;
             if (!viz::loadFrameGeometry(simFramePath(dir, o.name, n, o.format), g, error))
@@ -656,7 +678,7 @@ private:
                 }
             objects.push_back(j);
         }
-        reply(res, json{{"frame", n}, {"run", mRunId.load()}, {"objects", objects}});
+        reply(res, json{{"frame", n}, {"run", run}, {"objects", objects}});
     }
 
     // The simulation's run.json (written at most once a second while it runs, then at the end)
@@ -816,6 +838,9 @@ private:
     int mRuns = 0;
     std::mutex mSimMutex;                 // starting and stopping the simulation, mTempDir
     bool mShuttingDown = false;           // (under mSimMutex) stop() has begun
+    std::string mPrevDir;                 // (under mSimMutex) the run the last edit replaced
+    int mPrevRun = 0;
+    std::vector<SimObject> mPrevObjects;
     std::atomic<int> mRunId{0};           // the current run, in its events
     std::atomic<bool> mSimulateOn{false}; // Simulate pressed and not stopped: edits re-simulate
     std::mutex mStopMutex, mWaitMutex;

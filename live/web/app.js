@@ -21,7 +21,7 @@ live.screenBox = (name) => view.screenBox(name);
 live.setTime = (t) => setTime(t);
 const timeline = new Timeline($('timeline'), (t) => setTime(t));
 let state = null, scene = null, fieldData = null, currentFile = null;
-let time = 0, playing = false, simFrames = [], shownFrame = null, simRun = 0, endedRun = null;
+let time = 0, playing = false, simFrames = [], shownFrame = null, simRun = 0, endedRun = null, previousRun = null;
 
 function sliceRequest() {
   const axis = Number($('sliceAxis').value);
@@ -177,6 +177,7 @@ async function showSimFrame(f) {
       drawSimFrame();
       live.simFrameShown = n;
       live.simFrameRun = fr.run;
+      showCompare(n);
     } else {
       shownFrame = null; // (a frame of a replaced run: ask again)
     }
@@ -186,6 +187,24 @@ async function showSimFrame(f) {
   } finally {
     frameBusy = false;
     if (frameWanted !== null) { const w = frameWanted; frameWanted = null; showSimFrame(w); }
+  }
+}
+
+// Compare: the same frame of the run the last edit replaced, over the shown one.
+async function showCompare(n) {
+  if (!$('showCompare').checked || !previousRun || n === null) {
+    view.setCompareFrame([]);
+    live.compareShown = null;
+    return;
+  }
+  try {
+    const fr = await api(`/api/frame?n=${n}&run=${previousRun}`);
+    if (shownFrame !== n) return;
+    view.setCompareFrame(fr.objects);
+    live.compareShown = { run: fr.run, frame: n };
+  } catch (e) {
+    view.setCompareFrame([]); // (that run did not reach frame n)
+    live.compareShown = null;
   }
 }
 
@@ -272,6 +291,7 @@ function events() {
       }
       simRun = s.run;
       live.simRun = s.run;
+      previousRun = s.previous || null;
     }
     if (s.run !== undefined && s.run !== simRun) return;
     $('simulate').textContent = s.running || s.on ? 'Stop' : 'Simulate';
@@ -323,6 +343,7 @@ function wire() {
     }
   };
   $('showStrain').onchange = () => drawSimFrame();
+  $('showCompare').onchange = () => showCompare(shownFrame);
   renderStrainLegend($('strainBar'), $('strainTicks'));
   view.onRakeMoved = refreshField;
   draggable($('legend'));

@@ -42,7 +42,7 @@ export class View {
     sun.position.set(3, 5, 4);
     this.scene.add(sun);
     this.groups = {};
-    for (const name of ['slice', 'arrows', 'lines', 'rest', 'bodies', 'rigs', 'box', 'rake', 'sim']) {
+    for (const name of ['slice', 'arrows', 'lines', 'rest', 'bodies', 'rigs', 'box', 'rake', 'sim', 'compare']) {
       this.groups[name] = new THREE.Group();
       this.scene.add(this.groups[name]);
     }
@@ -337,6 +337,29 @@ export class View {
       }
     }
     this.groups.rest.visible = objects.length === 0 && this.groups.bodies.visible;
+    this.render();
+  }
+
+  // Another run's frame over the shown one (compare): its cloth as an orange wireframe, its
+  // hair as orange lines; nothing for an empty list.
+  setCompareFrame(objects) {
+    this.clear('compare');
+    const mat = new THREE.LineBasicMaterial({ color: 0xff9a3c, transparent: true, opacity: 0.8 });
+    for (const o of objects) {
+      const pos = [];
+      const P = o.points;
+      const seg = (i, j) => pos.push(P[3 * i], P[3 * i + 1], P[3 * i + 2], P[3 * j], P[3 * j + 1], P[3 * j + 2]);
+      for (let k = 0; k + 2 < o.triangles.length; k += 3) {
+        const [a, b, c] = [o.triangles[k], o.triangles[k + 1], o.triangles[k + 2]];
+        seg(a, b); seg(b, c); seg(c, a);
+      }
+      for (const line of o.polylines) for (let k = 0; k + 1 < line.length; ++k) seg(line[k], line[k + 1]);
+      const geo = new THREE.BufferGeometry();
+      geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+      const lines = new THREE.LineSegments(geo, mat.clone());
+      lines.name = 'compare:' + o.label;
+      this.groups.compare.add(lines);
+    }
     this.render();
   }
 

@@ -8,7 +8,7 @@
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { Checks, launch, canvasPixels, sleep } from './page_helpers.mjs';
+import { Checks, launch, canvasPixels, differing, sleep } from './page_helpers.mjs';
 
 const { URL: url, DIR, GALE, SHOT } = process.env;
 const c = new Checks();
@@ -130,8 +130,24 @@ try {
     c.check(ref.length === b.length && diff <= 1.01e-4, `the new run's frame 3 is gale sim's of the edited scene (within the page's 1e-4 rounding: ${diff.toExponential(2)})`);
     fs.rmSync(out, { recursive: true, force: true });
   }
+  // ---- compare: the run the edit replaced, over the shown frame ----
+  await page.click('#simulate'); // Stop, so the shown frame stays put
+  await c.until(() => page.evaluate(() => /stopped|done/.test(document.getElementById('simText').textContent)), 10000, 'the new run stops');
+  await page.evaluate(() => window.galeLive.setTime(3 / 24));
+  await c.until(() => page.evaluate(() => window.galeLive.simFrameShown === 3), 5000, 'frame 3 of the new run is shown');
+  await sleep(200);
+  const flagBox = await page.evaluate(() => window.galeLive.screenBox('flag'));
+  const before = flagBox ? await canvasPixels(page, flagBox) : null;
+  await page.evaluate(() => document.getElementById('showCompare').click());
+  const compared = await c.until(() => page.evaluate(() => window.galeLive.compareShown), 5000, 'the previous run is drawn over the frame');
+  if (compared) {
+    c.check(compared.run === lastRun - 1 && compared.frame === 3, `compare shows frame ${compared.frame} of run ${compared.run} (the one run ${lastRun} replaced)`);
+    await sleep(200);
+    const after = await canvasPixels(page, flagBox);
+    const changed = differing(before, after);
+    c.check(changed > 0.01, `the previous run's flag shows inside the flag's box: ${(100 * changed).toFixed(1)} % of its pixels change`);
+  }
   await page.screenshot({ path: SHOT });
-  await page.click('#simulate'); // Stop
   if (c.failures) console.log(logs.join('\n'));
 } finally {
   await close();
