@@ -83,7 +83,6 @@ void EventStreams::stop() {
         if (mStopped) return;
         mStopped = true;
     }
-    mHub.close();
     if (mThread.joinable()) {
         wakeUp(mWake);
         mThread.join();

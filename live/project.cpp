@@ -11,8 +11,8 @@
 #include "scene/sim_scene.h"
 #include "solver/bodies/body.h"
 #include "solver/collider/collider.h"
-#include "solver/mesh/mesh_sequence.h"
 #include "solver/collider/moving_collider.h"
+#include "solver/mesh/mesh_sequence.h"
 #include "viz/overlays.h"
 
 #include <algorithm>

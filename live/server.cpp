@@ -422,21 +422,27 @@ private:
         const std::string oldDir = mSim.outDir();
         const std::vector<SimObject> oldObjects = mSim.objects();
         const int oldRun = mRunId;
+        const bool oldStepped = mSim.lastFrame() > first; // (wrote a frame after its first)
         mSim.stop(true); // (its exit event carries the old run's id)
         ++mRuns;
         mRunId = mRuns;
         if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
             return refuse(500, error);
         // The run an edit replaced is kept to compare with (/api/frame?run=), the one it had
-        // replaced is thrown away.
+        // replaced thrown away; a run replaced before it stepped (a slider still moving) is
+        // thrown away instead, and the one before it kept.
         if (restart && !oldDir.empty() && oldDir != dir) {
-            if (mOpt.simDir.empty() && !mPrevDir.empty() && mPrevDir != dir) {
+            const bool keep = oldStepped || mPrevDir.empty();
+            const std::string drop = keep ? mPrevDir : oldDir;
+            if (mOpt.simDir.empty() && !drop.empty() && drop != dir) {
                 std::error_code ec;
-                fs::remove_all(mPrevDir, ec);
+                fs::remove_all(drop, ec);
             }
-            mPrevDir = oldDir;
-            mPrevRun = oldRun;
-            mPrevObjects = oldObjects;
+            if (keep) {
+                mPrevDir = oldDir;
+                mPrevRun = oldRun;
+                mPrevObjects = oldObjects;
+            }
         }
         publish("sim", json{{"running", true},
                             {"dir", dir},
@@ -649,7 +655,9 @@ private:
             std::lock_guard<std::mutex> simLock(mSimMutex);
             const bool previous = want > 0 && want == mPrevRun;
             if (want > 0 && !previous && want != mRunId)
-                return fail(res, 404, "run " + std::to_string(want) + " is gone (the current and the one it replaced are kept)");
+                return fail(res, 404,
+                            "run " + std::to_string(want) +
+                                " is gone (the current and the one it replaced are kept)");
             dir = previous ? mPrevDir : mSim.outDir();
             simObjects = previous ? mPrevObjects : mSim.objects();
             run = previous ? mPrevRun : mRunId.load();
@@ -836,9 +844,9 @@ private:
     int mPort = 0;
     std::string mTempDir;
     int mRuns = 0;
-    std::mutex mSimMutex;                 // starting and stopping the simulation, mTempDir
-    bool mShuttingDown = false;           // (under mSimMutex) stop() has begun
-    std::string mPrevDir;                 // (under mSimMutex) the run the last edit replaced
+    std::mutex mSimMutex;       // starting and stopping the simulation, mTempDir
+    bool mShuttingDown = false; // (under mSimMutex) stop() has begun
+    std::string mPrevDir;       // (under mSimMutex) the run the last edit replaced
     int mPrevRun = 0;
     std::vector<SimObject> mPrevObjects;
     std::atomic<int> mRunId{0};           // the current run, in its events

@@ -3,8 +3,8 @@
 // cairo_overlays.cpp), PNG via an image surface, SVG via an SVG surface, both written
 // atomically, and contact sheets of thumbnails.
 #include "viz/cairo_painter.h"
-#include "viz/strain.h"
 #include "viz/slice_marks.h"
+#include "viz/strain.h"
 
 #include "io/atomic_file.h"
 

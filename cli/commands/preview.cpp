@@ -267,7 +267,8 @@ int runVizFrames(const VizOptions& o) {
         }
     }
     if (o.strain) {
-        // The rest shapes the solver starts from (as gale live's), each frame's strain against them.
+        // The rest shapes the solver starts from (as gale live's); each frame's strain against
+        // them.
         std::vector<std::unique_ptr<solver::Body>> bodies;
         std::vector<std::string> warnings;
         if (!scene::buildBodies(sim, bodies, errors, warnings, o.source.allowPaths)) {
@@ -280,7 +281,8 @@ int runVizFrames(const VizOptions& o) {
             viz::parseObjGeometry(obj, rest[k]);
         }
         for (auto& [f, gs] : geometry)
-            for (size_t k = 0; k < gs.size() && k < rest.size(); ++k) gs[k].strain = viz::vertexStrain(rest[k], gs[k]);
+            for (size_t k = 0; k < gs.size() && k < rest.size(); ++k)
+                gs[k].strain = viz::vertexStrain(rest[k], gs[k]);
     }
     for (auto& [f, gs] : geometry)
         for (const viz::GeometryOverlay& g : gs) all.push_back(&g);
