@@ -180,7 +180,8 @@ public:
             raise(ErrorKind::Argument, "t and frame must be finite numbers");
         fields::SampleTime when;
         when.fps = mWind.settings.fps;
-        when.time = t ? *t : frame ? *frame / when.fps : 0.0;
+        when.frameZero = mWind.settings.timeZero;
+        when.time = t ? *t : frame ? mWind.settings.frameTime(*frame) : 0.0;
         fields::GridSampleOptions options;
         options.threads = threads;
         std::vector<float> out;

@@ -5,6 +5,7 @@
 #include "fields/expression_field.h"
 #include "run/sim_json.h"
 #include "scene/load.h"
+#include "scene/scene_checks.h"
 
 namespace gale::run {
 
@@ -42,6 +43,8 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
     mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
     mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads);
+    for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast))
+        report += w.render() + '\n';
 
     mWorld = std::make_unique<solver::World>(scene::worldSettings(mScene, s.threads));
     mWorld->setWind(wind);
@@ -56,7 +59,7 @@ const std::string& SimRun::outputFormat(size_t i) const {
 }
 
 solver::FrameStats SimRun::initialFrame() const {
-    return initialStats(*mWorld, mFirst, fps());
+    return initialStats(*mWorld, mFirst, mScene.wind.settings.frameTime(mFirst));
 }
 
 } // namespace gale::run
