@@ -112,6 +112,7 @@ struct VizOptions {
     std::string sim;                 // the gale sim output folder (default "sim")
     std::string contactSheet;        // a gale wedge output folder
     bool noField = false;            // a plain backdrop instead of the field slice
+    bool strain = false;             // cloth and hair coloured by rest-relative strain
     std::string cell = "240x240";    // contact sheet thumbnail size
 };
 

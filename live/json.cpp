@@ -116,14 +116,32 @@ json sceneJson(const Project& p) {
     json rest = json::array(), colliders = json::array();
     for (const viz::GeometryOverlay& g : p.restGeometry()) rest.push_back(geometryJson(g));
     for (const ColliderShape& c : p.colliders()) {
-        json j = {{"name", c.name}, {"shape", c.shape},        {"a", vec(c.a)},
-                  {"b", vec(c.b)},  {"normal", vec(c.normal)}, {"radius", c.radius}};
+        json j = {{"name", c.name},    {"shape", c.shape},        {"a", vec(c.a)},
+                  {"b", vec(c.b)},     {"normal", vec(c.normal)}, {"radius", c.radius},
+                  {"moving", c.moving}};
         if (!c.mesh.points.empty()) j["mesh"] = geometryJson(c.mesh);
         colliders.push_back(j);
     }
     const viz::Box3& b = p.box();
     return {
         {"box", {{"lo", vec(b.lo)}, {"hi", vec(b.hi)}}}, {"rest", rest}, {"colliders", colliders}};
+}
+
+json collidersJson(const Project& p, double t) {
+    json colliders = json::array();
+    for (const ColliderShape& c : p.collidersAt(t)) {
+        json j = {{"name", c.name},    {"shape", c.shape},        {"a", vec(c.a)},
+                  {"b", vec(c.b)},     {"normal", vec(c.normal)}, {"radius", c.radius},
+                  {"moving", c.moving}};
+        if (c.moving) {
+            json pts = json::array();
+            for (const auto& q : c.mesh.points)
+                for (double x : q) pts.push_back(round4(x));
+            j["points"] = pts;
+        }
+        colliders.push_back(j);
+    }
+    return {{"t", t}, {"colliders", colliders}};
 }
 
 json fieldJson(const FieldFrame& f, const viz::SliceOverlays& o) {

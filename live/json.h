@@ -17,6 +17,11 @@ nlohmann::json stateJson(const Project& project, double time);
 // {"box": {lo, hi}, "rest": [geometry], "colliders": [...]}.
 nlohmann::json sceneJson(const Project& project);
 
+// {"t", "colliders": [{name, shape, a, b, normal, radius, moving, points?}]}: every collider
+// placed at time t as the solver places it; `points` (x,y,z,...) for mesh sequences, whose
+// triangles /api/scene gives.
+nlohmann::json collidersJson(const Project& project, double t);
+
 // {"slice": {nu, nv, bounds, axes, plane, speed: [...], max, top}, "arrows": {n, positions,
 // velocities, max}, "streamlines": [{points: [x,y,z,...], speed: [...]}], "overlays": {...},
 // "times": {...}}. Numbers are rounded to 1e-4 (m, m/s), which the page cannot tell apart.

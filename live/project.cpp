@@ -8,9 +8,11 @@
 #include "lang/diagnostics.h"
 #include "scene/document.h"
 #include "scene/load.h"
+#include "scene/sim_scene.h"
 #include "solver/bodies/body.h"
 #include "solver/collider/collider.h"
-#include "scene/sim_scene.h"
+#include "solver/collider/moving_collider.h"
+#include "solver/mesh/mesh_sequence.h"
 #include "viz/overlays.h"
 
 #include <algorithm>
@@ -19,6 +21,7 @@
 #include <fstream>
 #include <limits>
 #include <regex>
+#include <set>
 #include <sstream>
 
 namespace gale::live {
@@ -98,23 +101,86 @@ void fromSink(const lang::SourceFile& file, const lang::DiagnosticSink& sink,
     }
 }
 
-// String literals in an expression that name files beside it (sdf("body.obj"), vdb(...)).
-std::vector<std::string> namedFiles(const std::string& text, const std::string& dir) {
+// String literals in an expression that name files beside it (sdf("body.obj"), vdb(...));
+// those that name no file yet (a frame sequence `body/body.#.obj`, a mesh still to be written)
+// go to `missing`.
+std::vector<std::string> namedFiles(const std::string& text, const std::string& dir,
+                                    std::vector<std::string>* missing = nullptr) {
     std::vector<std::string> out;
     static const std::regex str(R"re("([^"\\\n]{1,400})")re");
     for (auto it = std::sregex_iterator(text.begin(), text.end(), str);
          it != std::sregex_iterator(); ++it) {
         const fs::path p = fs::path(dir) / (*it)[1].str();
         std::error_code ec;
-        if (fs::is_regular_file(p, ec)) out.push_back(p.lexically_normal().string());
+        if (fs::is_regular_file(p, ec))
+            out.push_back(p.lexically_normal().string());
+        else if (missing)
+            missing->push_back(p.lexically_normal().string());
     }
     return out;
 }
 
+// A string that could name a file gale reads: a '#' frame sequence or a known extension.
+bool looksLikeFile(const fs::path& p) {
+    static const std::set<std::string> exts = {".obj", ".ply",  ".se",  ".vdb", ".npy",
+                                               ".csv", ".json", ".mdd", ".toml"};
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return p.filename().string().find('#') != std::string::npos || exts.count(ext);
+}
+
+// One collider at time t: its pose (solver::colliderPose, the solver's own placement) and, for
+// a mesh sequence, its vertices at t (MeshSequence::positionsAt, as the contact code uses them).
+ColliderShape colliderAt(const solver::Collider& c, double t) {
+    const solver::ColliderPose pose = solver::colliderPose(c, t);
+    ColliderShape s;
+    s.name = c.name;
+    s.shape = c.shape == solver::ColliderShape::Plane     ? "plane"
+              : c.shape == solver::ColliderShape::Sphere  ? "sphere"
+              : c.shape == solver::ColliderShape::Capsule ? "capsule"
+                                                          : "mesh";
+    s.a = {pose.a[0], pose.a[1], pose.a[2]};
+    s.b = {pose.b[0], pose.b[1], pose.b[2]};
+    s.normal = {pose.normal[0], pose.normal[1], pose.normal[2]};
+    s.radius = pose.radius;
+    if (c.moving) {
+        const solver::MeshSequence& seq = c.moving->mesh();
+        std::vector<double> x;
+        seq.positionsAt(t, x);
+        s.moving = seq.moving();
+        s.mesh.label = c.name;
+        s.mesh.points.resize(x.size() / 3);
+        for (size_t v = 0; v < s.mesh.points.size(); ++v)
+            s.mesh.points[v] = {x[3 * v], x[3 * v + 1], x[3 * v + 2]};
+        for (const auto& tri : seq.triangles())
+            s.mesh.triangles.push_back({tri[0], tri[1], tri[2]});
+    }
+    return s;
+}
+
 } // namespace
+
+std::vector<ColliderShape> Project::collidersAt(double t) const {
+    std::vector<ColliderShape> out;
+    for (size_t i = 0; i < mSimColliders.size(); ++i) {
+        const solver::Collider& c = mSimColliders[i];
+        out.push_back(colliderAt(c, t));
+        if (c.shape == solver::ColliderShape::Mesh && !c.moving && i < mColliders.size())
+            out.back().mesh = mColliders[i].mesh;
+    }
+    return out;
+}
 
 Project::Project(std::string input, std::vector<std::string> allowPaths)
     : mInput(std::move(input)), mAllowPaths(std::move(allowPaths)) {}
+
+void Project::addPattern(const std::string& path) {
+    const fs::path p = fs::path(path).lexically_normal();
+    if (looksLikeFile(p) &&
+        std::find(mPatterns.begin(), mPatterns.end(), p.string()) == mPatterns.end())
+        mPatterns.push_back(p.string());
+}
 
 void Project::addFile(const std::string& path) {
     const std::string p = fs::path(path).lexically_normal().string();
@@ -123,6 +189,7 @@ void Project::addFile(const std::string& path) {
 
 bool Project::load() {
     mFiles.clear();
+    mPatterns.clear();
     mDiagnostics.clear();
     mParams.clear();
     mRamps.clear();
@@ -130,6 +197,7 @@ bool Project::load() {
     mScene.reset();
     mRest.clear();
     mColliders.clear();
+    mSimColliders.clear();
     mObjects.clear();
     addFile(mInput);
     std::string ext = fs::path(mInput).extension().string();
@@ -156,8 +224,10 @@ void Project::loadExpressionFile() {
         mParams.push_back({"", mInput, mInput, p, true, text.substr(p.begin, p.end - p.begin)});
     for (const RampLiteral& r : lits.ramps)
         mRamps.push_back({0, mInput, r, text.substr(r.begin, r.end - r.begin)});
-    for (const std::string& f : namedFiles(text, fs::path(mInput).parent_path().string()))
+    std::vector<std::string> missing;
+    for (const std::string& f : namedFiles(text, fs::path(mInput).parent_path().string(), &missing))
         addFile(f);
+    for (const std::string& m : missing) addPattern(m);
     fields::ExpressionFieldOptions options;
     options.files = geometry::fileAccessFor(mInput, mAllowPaths);
     lang::DiagnosticSink sink;
@@ -181,8 +251,10 @@ void Project::loadSceneFile() {
     std::vector<gale::scene::SceneError> syntax;
     const bool parsed = doc.parse(mInput, sceneText, syntax);
     const std::string baseDir = fs::path(mInput).parent_path().string();
-    if (parsed)
+    if (parsed) {
         for (const std::string& f : doc.namedFiles()) addFile(f);
+        for (const std::string& p : doc.otherPaths()) addPattern(p); // (not there yet: watched for)
+    }
     const bool loaded = gale::scene::loadSimScene(mInput, sim, errors);
     for (const gale::scene::SceneError& e : errors) {
         std::string text = e.render();
@@ -205,9 +277,11 @@ void Project::loadSceneFile() {
         std::string text;
         if (!readText(entry.exprPath, text, error)) continue; // buildSceneField reports it
         const lang::SourceFile file(entry.exprPath, text);
+        std::vector<std::string> missing;
         for (const std::string& f :
-             namedFiles(text, fs::path(entry.exprPath).parent_path().string()))
+             namedFiles(text, fs::path(entry.exprPath).parent_path().string(), &missing))
             addFile(f);
+        for (const std::string& m : missing) addPattern(m);
         const SourceLiterals lits = findLiterals(file);
         for (const ParamLiteral& p : lits.params) {
             LiveParam lp{entry.name, entry.exprPath, entry.exprPath,
@@ -262,21 +336,12 @@ void Project::loadSceneFile() {
             mDiagnostics.push_back({e.file, e.line, e.col, "error", e.message, text});
         }
     }
+    mSimColliders = sim.colliders;
     for (size_t i = 0; i < sim.colliders.size(); ++i) {
         const solver::Collider& c = sim.colliders[i];
-        const solver::ColliderPose pose = solver::colliderPose(c, 0.0);
-        ColliderShape s;
-        s.name = c.name;
-        s.shape = c.shape == solver::ColliderShape::Plane     ? "plane"
-                  : c.shape == solver::ColliderShape::Sphere  ? "sphere"
-                  : c.shape == solver::ColliderShape::Capsule ? "capsule"
-                                                              : "mesh";
-        s.a = {pose.a[0], pose.a[1], pose.a[2]};
-        s.b = {pose.b[0], pose.b[1], pose.b[2]};
-        s.normal = {pose.normal[0], pose.normal[1], pose.normal[2]};
-        s.radius = pose.radius;
+        ColliderShape s = colliderAt(c, 0.0);
         const std::string mesh = parsed ? doc.colliderMesh(i) : std::string();
-        if (c.shape == solver::ColliderShape::Mesh && !mesh.empty()) {
+        if (c.shape == solver::ColliderShape::Mesh && !c.moving && !mesh.empty()) {
             std::string err;
             viz::loadFrameGeometry((fs::path(baseDir) / mesh).string(), s.mesh, err);
         }
@@ -305,6 +370,19 @@ void Project::computeBox() {
         if (c.shape == "capsule") grow(c.b, c.radius);
         for (const auto& p : c.mesh.points) grow(p, 0.0);
     }
+    // A mesh sequence anywhere along its motion (a walking body leaves its first pose).
+    for (const solver::Collider& c : mSimColliders)
+        if (c.moving && c.moving->mesh().moving()) {
+            const solver::MeshSequence& seq = c.moving->mesh();
+            const long n = static_cast<long>(seq.frameCount());
+            std::vector<double> x;
+            for (long k = 0; k < n; k += std::max(1L, n / 8)) {
+                seq.positionsAt(static_cast<double>(seq.firstFrame() + k) / seq.fps(), x);
+                for (size_t i = 0; i + 2 < x.size(); i += 3) grow({x[i], x[i + 1], x[i + 2]}, 0.0);
+            }
+            seq.positionsAt(static_cast<double>(seq.firstFrame() + n - 1) / seq.fps(), x);
+            for (size_t i = 0; i + 2 < x.size(); i += 3) grow({x[i], x[i + 1], x[i + 2]}, 0.0);
+        }
     if (!(hi[0] >= lo[0])) {
         mBox = viz::Box3{};
         mBox.lo = {-2, -2, -2};

@@ -8,6 +8,7 @@
 #include "fields/scene.h"
 #include "live/literals.h"
 #include "live/sim_job.h"
+#include "solver/collider/collider.h"
 #include "viz/picture.h"
 #include "viz/volume_marks.h"
 
@@ -53,6 +54,7 @@ struct ColliderShape {
     std::array<double, 3> a{}, b{}, normal{0.0, 1.0, 0.0};
     double radius = 0.0;
     viz::GeometryOverlay mesh; // mesh colliders: the mesh file's triangles
+    bool moving = false;       // a mesh sequence: `mesh` is its pose at one time
 };
 
 class Project {
@@ -69,6 +71,9 @@ public:
     bool isScene() const { return mScene != nullptr; }
     // Every file the input names that exists: the input, expression files, meshes, strands.
     const std::vector<std::string>& files() const { return mFiles; }
+    // Paths the input names that are not files yet (a `#` frame sequence such as
+    // `body/body.#.obj`, a mesh still to be written): watched for, never served.
+    const std::vector<std::string>& patterns() const { return mPatterns; }
     const std::vector<Diagnostic>& diagnostics() const { return mDiagnostics; }
     const std::vector<LiveParam>& params() const { return mParams; }
     const std::vector<LiveRamp>& ramps() const { return mRamps; }
@@ -79,6 +84,10 @@ public:
     int frameEnd() const { return mFrameEnd; }
     const std::vector<viz::GeometryOverlay>& restGeometry() const { return mRest; }
     const std::vector<ColliderShape>& colliders() const { return mColliders; }
+    // The colliders as the solver places them at time t (s): keyframed planes, spheres and
+    // capsules at their pose (solver::colliderPose), mesh sequences' vertices interpolated by
+    // solver::MeshSequence::positionsAt, static meshes as loaded.
+    std::vector<ColliderShape> collidersAt(double t) const;
     // The scene's cloth and hair as gale sim names their frame files.
     const std::vector<SimObject>& simObjects() const { return mObjects; }
     // Around the rest geometry and colliders (padded), else -2..2 on each axis.
@@ -97,6 +106,7 @@ private:
     void loadExpressionFile();
     void loadSceneFile();
     void addFile(const std::string& path);
+    void addPattern(const std::string& path);
     void computeBox();
     bool rewrite(const std::string& file, const std::function<bool(std::string&)>& edit,
                  std::string& error);
@@ -104,6 +114,7 @@ private:
     std::string mInput;
     std::vector<std::string> mAllowPaths;
     std::vector<std::string> mFiles;
+    std::vector<std::string> mPatterns;
     std::vector<Diagnostic> mDiagnostics;
     std::vector<LiveParam> mParams;
     std::vector<LiveRamp> mRamps;
@@ -113,6 +124,7 @@ private:
     int mFrameStart = 1, mFrameEnd = 48;
     std::vector<viz::GeometryOverlay> mRest;
     std::vector<ColliderShape> mColliders;
+    std::vector<solver::Collider> mSimColliders; // as loaded (mesh sequences shared)
     std::vector<SimObject> mObjects;
     viz::Box3 mBox;
 };

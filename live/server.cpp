@@ -4,19 +4,27 @@
 // read, and only the scene's files (by literal edits) and the simulation folder are written.
 #include "live/server.h"
 
-#include "live/events.h"
+#include "live/event_streams.h"
 #include "live/json.h"
 #include "live/project.h"
 #include "live/sim_job.h"
 #include "live/watcher.h"
 #include "viz/overlays.h"
+#include "viz/strain.h"
 
 #include <httplib.h>
 
+#include <arpa/inet.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -105,6 +113,125 @@ bool intParam(const httplib::Request& req, const char* name, int def, int lo, in
     return true;
 }
 
+// A connection's socket as httplib's Stream, with a read buffer kept over its keep-alive
+// requests. Once an event stream has taken the socket over (take()), writes are swallowed:
+// httplib's reply to that request never reaches the wire, EventStreams writes instead.
+class SocketStream final : public httplib::Stream {
+public:
+    SocketStream(int fd, int readMs, int writeMs) : mFd(fd), mReadMs(readMs), mWriteMs(writeMs) {}
+    bool is_readable() const override { return mPos < mLen || ready(POLLIN, mReadMs); }
+    bool is_writable() const override { return mTaken || ready(POLLOUT, mWriteMs); }
+    ssize_t read(char* ptr, size_t size) override {
+        if (mPos == mLen) {
+            if (!ready(POLLIN, mReadMs)) return -1;
+            ssize_t n;
+            do n = ::recv(mFd, mBuf, sizeof mBuf, 0);
+            while (n < 0 && errno == EINTR);
+            if (n <= 0) return n;
+            mPos = 0;
+            mLen = static_cast<size_t>(n);
+        }
+        const size_t k = std::min(size, mLen - mPos);
+        std::memcpy(ptr, mBuf + mPos, k);
+        mPos += k;
+        return static_cast<ssize_t>(k);
+    }
+    ssize_t write(const char* ptr, size_t size) override {
+        if (mTaken) return static_cast<ssize_t>(size);
+        if (!ready(POLLOUT, mWriteMs)) return -1;
+        ssize_t n;
+        do n = ::send(mFd, ptr, size, MSG_NOSIGNAL);
+        while (n < 0 && errno == EINTR);
+        return n;
+    }
+    void get_remote_ip_and_port(std::string& ip, int& port) const override {
+        address(::getpeername, ip, port);
+    }
+    void get_local_ip_and_port(std::string& ip, int& port) const override {
+        address(::getsockname, ip, port);
+    }
+    socket_t socket() const override { return mFd; }
+    bool buffered() const { return mPos < mLen; }
+    void take() { mTaken = true; }
+    bool taken() const { return mTaken; }
+
+private:
+    bool ready(short what, int ms) const {
+        pollfd p{mFd, what, 0};
+        int r;
+        do r = ::poll(&p, 1, ms);
+        while (r < 0 && errno == EINTR);
+        return r > 0 && (p.revents & (what | POLLHUP | POLLERR));
+    }
+    template <typename Get>
+    void address(Get get, std::string& ip, int& port) const {
+        sockaddr_storage a{};
+        socklen_t len = sizeof a;
+        ip.clear();
+        port = 0;
+        if (get(mFd, reinterpret_cast<sockaddr*>(&a), &len) != 0) return;
+        char text[INET6_ADDRSTRLEN] = "";
+        if (a.ss_family == AF_INET) {
+            const auto* v4 = reinterpret_cast<const sockaddr_in*>(&a);
+            inet_ntop(AF_INET, &v4->sin_addr, text, sizeof text);
+            port = ntohs(v4->sin_port);
+        } else if (a.ss_family == AF_INET6) {
+            const auto* v6 = reinterpret_cast<const sockaddr_in6*>(&a);
+            inet_ntop(AF_INET6, &v6->sin6_addr, text, sizeof text);
+            port = ntohs(v6->sin6_port);
+        }
+        ip = text;
+    }
+
+    int mFd;
+    int mReadMs, mWriteMs;
+    char mBuf[4096];
+    size_t mPos = 0, mLen = 0;
+    bool mTaken = false;
+};
+
+// The connection being served on this worker thread (the /api/events handler takes it over).
+thread_local SocketStream* tConnection = nullptr;
+
+// cpp-httplib's server with its per-connection loop replaced (the same keep-alive rules) so
+// that an /api/events request can hand its socket to EventStreams and free the worker: with
+// cpp-httplib's own loop every open stream held one of the pool's threads.
+class HttpServer final : public httplib::Server {
+private:
+    bool process_and_close_socket(socket_t sock) override {
+        SocketStream strm(sock,
+                          static_cast<int>(read_timeout_sec_ * 1000 + read_timeout_usec_ / 1000),
+                          static_cast<int>(write_timeout_sec_ * 1000 + write_timeout_usec_ / 1000));
+        tConnection = &strm;
+        bool ok = false;
+        for (size_t left = keep_alive_max_count_; left > 0; --left) {
+            if (!strm.buffered() && !keepAlive(sock)) break;
+            bool closed = false;
+            ok = process_request(strm, left == 1, closed, nullptr);
+            if (!ok || closed || strm.taken()) break;
+        }
+        tConnection = nullptr;
+        if (!strm.taken()) {
+            ::shutdown(sock, SHUT_RDWR);
+            ::close(sock);
+        }
+        return ok;
+    }
+    // Waits up to the keep-alive timeout for the next request, giving up when the server stops.
+    bool keepAlive(int sock) const {
+        const auto end =
+            std::chrono::steady_clock::now() + std::chrono::seconds(keep_alive_timeout_sec_);
+        while (svr_sock_ != INVALID_SOCKET) {
+            pollfd p{sock, POLLIN, 0};
+            const int r = ::poll(&p, 1, 100);
+            if (r > 0) return true;
+            if (r < 0 && errno != EINTR) return false;
+            if (std::chrono::steady_clock::now() >= end) return false;
+        }
+        return false;
+    }
+};
+
 } // namespace
 
 class Server::Impl {
@@ -114,10 +241,14 @@ public:
           mWatcher([this](const std::set<std::string>& files) { onFilesChanged(files); }, 15),
           mSim(
               [this](long f) {
-                  publish("frame", json{{"frame", f}});
+                  publish("frame", json{{"frame", f}, {"run", mRunId.load()}});
               },
               [this](int code, const std::string& log) {
-                  publish("sim", json{{"running", false}, {"exit", code}, {"log", log}});
+                  publish("sim", json{{"running", false},
+                                      {"exit", code},
+                                      {"log", log},
+                                      {"run", mRunId.load()},
+                                      {"on", mSimulateOn.load()}});
               }) {
         if (mOpt.token.empty()) mOpt.token = randomToken();
         if (mOpt.webDir.empty()) mOpt.webDir = GALE_LIVE_WEB_DIR;
@@ -134,7 +265,7 @@ public:
             std::lock_guard<std::mutex> lock(mMutex);
             mProject.load();
         }
-        if (!mWatcher.start(error)) return false;
+        if (!mWatcher.start(error) || !mEvents.start(error)) return false;
         watchProjectFiles();
         routes();
         // SO_REUSEADDR only: cpp-httplib's default adds SO_REUSEPORT, with which a second
@@ -167,11 +298,16 @@ public:
         std::lock_guard<std::mutex> stopping(mStopMutex);
         if (mStopped) return;
         mStopped = true;
-        mEvents.close();
-        mSim.stop();
-        if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
-            std::error_code ec;
-            fs::remove_all(mTempDir, ec);
+        mSimulateOn = false;
+        mEvents.stop();
+        {
+            std::lock_guard<std::mutex> simLock(mSimMutex);
+            mShuttingDown = true; // (a reload on the watcher's thread starts no new run now)
+            mSim.stop();
+            if (!mTempDir.empty()) { // the simulations' folder this server made under /tmp
+                std::error_code ec;
+                fs::remove_all(mTempDir, ec);
+            }
         }
         mWatcher.stop();
         mHttp.stop();
@@ -204,12 +340,13 @@ public:
 
 private:
     void watchProjectFiles() {
-        std::set<std::string> files;
+        std::set<std::string> files, patterns;
         {
             std::lock_guard<std::mutex> lock(mMutex);
             files.insert(mProject.files().begin(), mProject.files().end());
+            patterns.insert(mProject.patterns().begin(), mProject.patterns().end());
         }
-        mWatcher.watch(files);
+        mWatcher.watch(files, patterns);
     }
 
     // A reload after edits: the new files are watched; `field` when it compiled, else
@@ -238,6 +375,83 @@ private:
         }
         watchProjectFiles();
         publish(ok ? "field" : "diagnostics", event);
+        // Live re-simulation: while Simulate is on, an edit that compiles restarts the run from
+        // the first frame with the new scene (the old child killed by its pid).
+        if (ok && mSimulateOn) {
+            std::string error;
+            if (!startSimulation(true, error))
+                publish("sim", json{{"running", false}, {"exit", 1}, {"log", error}});
+        }
+    }
+
+    // Starts (or, `restart`, replaces) the background `gale sim` in a new folder. False with
+    // `error` (and the HTTP status in `status`) when it cannot.
+    bool startSimulation(bool restart, std::string& error, int* status = nullptr) {
+        std::lock_guard<std::mutex> simLock(mSimMutex);
+        auto refuse = [&](int code, const std::string& message) {
+            if (status) *status = code;
+            error = message;
+            return false;
+        };
+        if (mShuttingDown) return refuse(503, "the server is stopping");
+        if (restart && !mSimulateOn) return true; // (stopped since the edit was seen)
+        if (mOpt.galeExecutable.empty())
+            return refuse(409, "simulation is not available in this server");
+        std::vector<SimObject> objects;
+        long first, last;
+        bool scene;
+        {
+            std::lock_guard<std::mutex> lock(mMutex);
+            objects = mProject.simObjects();
+            first = mProject.frameStart();
+            last = mProject.frameEnd();
+            scene = mProject.isScene();
+        }
+        if (!scene || objects.empty())
+            return refuse(
+                409, "nothing to simulate: give gale live a SCENE.toml with [[cloth]] or [[hair]]");
+        std::string dir = mOpt.simDir;
+        if (dir.empty()) {
+            if (mTempDir.empty()) {
+                char tmpl[] = "/tmp/gale-live-XXXXXX";
+                if (!mkdtemp(tmpl)) return refuse(500, "cannot create a folder for the simulation");
+                mTempDir = tmpl;
+            }
+            dir = mTempDir + "/sim" + std::to_string(mRuns + 1);
+        }
+        const std::string oldDir = mSim.outDir();
+        const std::vector<SimObject> oldObjects = mSim.objects();
+        const int oldRun = mRunId;
+        const bool oldStepped = mSim.lastFrame() > first; // (wrote a frame after its first)
+        mSim.stop(true); // (its exit event carries the old run's id)
+        ++mRuns;
+        mRunId = mRuns;
+        if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
+            return refuse(500, error);
+        // The run an edit replaced is kept to compare with (/api/frame?run=), the one it had
+        // replaced thrown away; a run replaced before it stepped (a slider still moving) is
+        // thrown away instead, and the one before it kept.
+        if (restart && !oldDir.empty() && oldDir != dir) {
+            const bool keep = oldStepped || mPrevDir.empty();
+            const std::string drop = keep ? mPrevDir : oldDir;
+            if (mOpt.simDir.empty() && !drop.empty() && drop != dir) {
+                std::error_code ec;
+                fs::remove_all(drop, ec);
+            }
+            if (keep) {
+                mPrevDir = oldDir;
+                mPrevRun = oldRun;
+                mPrevObjects = oldObjects;
+            }
+        }
+        publish("sim", json{{"running", true},
+                            {"dir", dir},
+                            {"frames", {first, last}},
+                            {"run", mRunId.load()},
+                            {"restart", restart},
+                            {"previous", mPrevRun},
+                            {"on", true}});
+        return true;
     }
 
     bool authorised(const httplib::Request& req, httplib::Response& res) {
@@ -314,12 +528,23 @@ private:
                       asset(res, a->second.first, a->second.second);
                   });
         mHttp.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
-            std::lock_guard<std::mutex> lock(mMutex);
-            reply(res, stateJson(mProject, mTime));
+            json state;
+            {
+                std::lock_guard<std::mutex> lock(mMutex);
+                state = stateJson(mProject, mTime);
+            }
+            state["eventStreams"] = mEvents.count();
+            reply(res, state);
         });
         mHttp.Get("/api/scene", [this](const httplib::Request&, httplib::Response& res) {
             std::lock_guard<std::mutex> lock(mMutex);
             reply(res, sceneJson(mProject));
+        });
+        mHttp.Get("/api/colliders", [this](const httplib::Request& req, httplib::Response& res) {
+            double t = 0;
+            if (!numberParam(req, "t", 0.0, t)) return fail(res, 400, "t: a time in seconds");
+            std::lock_guard<std::mutex> lock(mMutex);
+            reply(res, collidersJson(mProject, t));
         });
         mHttp.Get("/api/file", [this](const httplib::Request& req, httplib::Response& res) {
             const std::string path =
@@ -339,6 +564,8 @@ private:
         });
         mHttp.Get("/api/field",
                   [this](const httplib::Request& req, httplib::Response& res) { field(req, res); });
+        mHttp.Get("/api/run",
+                  [this](const httplib::Request&, httplib::Response& res) { run(res); });
         mHttp.Get("/api/frame",
                   [this](const httplib::Request& req, httplib::Response& res) { frame(req, res); });
         mHttp.Post("/api/param", [this](const httplib::Request& req, httplib::Response& res) {
@@ -350,29 +577,20 @@ private:
         mHttp.Post("/api/simulate", [this](const httplib::Request& req, httplib::Response& res) {
             simulate(req, res);
         });
-        mHttp.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
-            res.set_header("Cache-Control", "no-store");
-            auto last = std::make_shared<uint64_t>(mEvents.latest());
-            auto hello = std::make_shared<bool>(false);
-            res.set_chunked_content_provider(
-                "text/event-stream", [this, last, hello](size_t, httplib::DataSink& sink) {
-                    if (!*hello) {
-                        *hello = true;
-                        const std::string h = "retry: 1000\n: gale live\n\n";
-                        return sink.write(h.data(), h.size());
-                    }
-                    Event e;
-                    for (int waited = 0; waited < 15000; waited += 500) {
-                        if (mEvents.closed() || !sink.is_writable()) return false;
-                        if (mEvents.next(*last, 500, e)) {
-                            *last = e.id;
-                            const std::string text = eventText(e);
-                            return sink.write(text.data(), text.size());
-                        }
-                    }
-                    const std::string ping = ": ping\n\n";
-                    return sink.write(ping.data(), ping.size());
-                });
+        // The socket is handed to EventStreams (no worker is held while the stream is open);
+        // Last-Event-ID (an EventSource reconnecting) resumes after the last event it had.
+        mHttp.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
+            SocketStream* conn = tConnection;
+            if (!conn) return fail(res, 500, "no connection to stream events on");
+            uint64_t after = mEvents.latest();
+            const std::string last = req.get_header_value("Last-Event-ID");
+            if (!last.empty()) {
+                char* end = nullptr;
+                const unsigned long long id = std::strtoull(last.c_str(), &end, 10);
+                if (end == last.c_str() + last.size() && id < after) after = id;
+            }
+            conn->take();
+            mEvents.adopt(conn->socket(), after);
         });
     }
 
@@ -428,18 +646,89 @@ private:
         int n = 0;
         if (!intParam(req, "n", -1, -1000000, 1000000, n))
             return fail(res, 400, "n: a frame number");
-        const std::string dir = mSim.outDir();
+        int want = 0;
+        if (!intParam(req, "run", 0, 0, 1 << 30, want)) return fail(res, 400, "run: a run number");
+        std::string dir;
+        std::vector<SimObject> simObjects;
+        int run;
+        {
+            std::lock_guard<std::mutex> simLock(mSimMutex);
+            const bool previous = want > 0 && want == mPrevRun;
+            if (want > 0 && !previous && want != mRunId)
+                return fail(res, 404,
+                            "run " + std::to_string(want) +
+                                " is gone (the current and the one it replaced are kept)");
+            dir = previous ? mPrevDir : mSim.outDir();
+            simObjects = previous ? mPrevObjects : mSim.objects();
+            run = previous ? mPrevRun : mRunId.load();
+        }
         if (dir.empty()) return fail(res, 404, "no simulation yet: POST /api/simulate");
+        std::vector<viz::GeometryOverlay> rest;
+        {
+            std::lock_guard<std::mutex> lock(mMutex);
+            rest = mProject.restGeometry();
+        }
         json objects = json::array();
-        for (const SimObject& o : mSim.objects()) {
+        for (const SimObject& o : simObjects) {
             viz::GeometryOverlay g;
             std::string error;
             if (!viz::loadFrameGeometry(simFramePath(dir, o.name, n, o.format), g, error))
                 return fail(res, 404, "frame " + std::to_string(n) + " is not written yet");
             g.label = o.name;
-            objects.push_back(geometryJson(g));
+            json j = geometryJson(g);
+            // Strain against the rest shape the solver starts from (viz/strain.h), per vertex.
+            for (const viz::GeometryOverlay& r : rest)
+                if (r.label == o.name) {
+                    json strain = json::array();
+                    for (double x : viz::vertexStrain(r, g))
+                        strain.push_back(std::round(x * 1e4) / 1e4);
+                    j["strain"] = strain;
+                }
+            objects.push_back(j);
         }
-        reply(res, json{{"frame", n}, {"objects", objects}});
+        reply(res, json{{"frame", n}, {"run", run}, {"objects", objects}});
+    }
+
+    // The simulation's run.json (written at most once a second while it runs, then at the end)
+    // summarised per frame for the timeline: contacts, halved and recovered substeps, the
+    // largest stretch against [solver] over_stretch, failures, and each object's events.
+    void run(httplib::Response& res) {
+        const std::string dir = mSim.outDir();
+        if (dir.empty()) return fail(res, 404, "no simulation yet: POST /api/simulate");
+        std::string text;
+        if (!readFile((fs::path(dir) / "run.json").string(), text, 64u << 20))
+            return reply(res, json{{"status", "starting"}, {"frames", json::array()}});
+        const json run = json::parse(text, nullptr, false);
+        if (run.is_discarded() || !run.is_object())
+            return reply(res, json{{"status", "starting"}, {"frames", json::array()}});
+        const double overStretch = run.value("/settings/solver/over_stretch"_json_pointer, 3.0);
+        json frames = json::array();
+        for (const json& f : run.value("frames", json::array())) {
+            long contacts = 0, halved = 0, recovered = 0;
+            double stretch = 0;
+            json events = json::array();
+            for (const json& o : f.value("objects", json::array())) {
+                contacts += o.value("contacts", 0L);
+                halved += o.value("rejected_substeps", 0L);
+                recovered += o.value("recovered_substeps", 0L);
+                stretch = std::max(stretch, o.value("max_stretch", 0.0));
+                for (const json& e : o.value("events", json::array()))
+                    if (e.is_string())
+                        events.push_back(o.value("name", std::string()) + ": " +
+                                         e.get<std::string>());
+            }
+            frames.push_back({{"frame", f.value("frame", 0L)},
+                              {"failed", f.value("failed", false)},
+                              {"contacts", contacts},
+                              {"halved", halved},
+                              {"recovered", recovered},
+                              {"maxStretch", stretch},
+                              {"overStretched", stretch >= overStretch},
+                              {"events", events}});
+        }
+        reply(res, json{{"status", run.value("status", std::string())},
+                        {"overStretch", overStretch},
+                        {"frames", frames}});
     }
 
     bool bodyJson(const httplib::Request& req, httplib::Response& res, json& out) {
@@ -525,58 +814,43 @@ private:
         if (!bodyJson(req, res, body)) return;
         const std::string action = body.value("action", std::string("start"));
         if (action == "stop") {
+            std::lock_guard<std::mutex> simLock(mSimMutex);
+            mSimulateOn = false;
             mSim.stop();
         } else if (action == "start") {
-            if (mOpt.galeExecutable.empty())
-                return fail(res, 409, "simulation is not available in this server");
-            std::vector<SimObject> objects;
-            long first, last;
-            bool scene;
-            {
-                std::lock_guard<std::mutex> lock(mMutex);
-                objects = mProject.simObjects();
-                first = mProject.frameStart();
-                last = mProject.frameEnd();
-                scene = mProject.isScene();
-            }
-            if (!scene || objects.empty())
-                return fail(
-                    res, 409,
-                    "nothing to simulate: give gale live a SCENE.toml with [[cloth]] or [[hair]]");
-            std::string dir = mOpt.simDir;
-            if (dir.empty()) {
-                if (mTempDir.empty()) {
-                    char tmpl[] = "/tmp/gale-live-XXXXXX";
-                    if (!mkdtemp(tmpl))
-                        return fail(res, 500, "cannot create a folder for the simulation");
-                    mTempDir = tmpl;
-                }
-                dir = mTempDir + "/sim" + std::to_string(++mRuns);
-            }
             std::string error;
-            if (!mSim.start(mOpt.galeExecutable, mOpt.input, dir, objects, first, last, error))
-                return fail(res, 500, error);
-            publish("sim", json{{"running", true}, {"dir", dir}, {"frames", {first, last}}});
+            int status = 500;
+            if (!startSimulation(false, error, &status)) return fail(res, status, error);
+            mSimulateOn = true;
         } else {
             return fail(res, 400, "action: start or stop");
         }
-        reply(
-            res,
-            json{{"running", mSim.running()}, {"dir", mSim.outDir()}, {"last", mSim.lastFrame()}});
+        reply(res, json{{"running", mSim.running()},
+                        {"dir", mSim.outDir()},
+                        {"last", mSim.lastFrame()},
+                        {"run", mRunId.load()},
+                        {"on", mSimulateOn.load()}});
     }
 
     ServerOptions mOpt;
     std::mutex mMutex; // the project and mTime
     Project mProject;
     double mTime = 0.0;
-    EventHub mEvents;
+    EventStreams mEvents;
     FileWatcher mWatcher;
     SimJob mSim;
-    httplib::Server mHttp;
+    HttpServer mHttp;
     std::thread mThread;
     int mPort = 0;
     std::string mTempDir;
     int mRuns = 0;
+    std::mutex mSimMutex;       // starting and stopping the simulation, mTempDir
+    bool mShuttingDown = false; // (under mSimMutex) stop() has begun
+    std::string mPrevDir;       // (under mSimMutex) the run the last edit replaced
+    int mPrevRun = 0;
+    std::vector<SimObject> mPrevObjects;
+    std::atomic<int> mRunId{0};           // the current run, in its events
+    std::atomic<bool> mSimulateOn{false}; // Simulate pressed and not stopped: edits re-simulate
     std::mutex mStopMutex, mWaitMutex;
     std::condition_variable mWaitCv;
     bool mStopped = false, mDone = false;

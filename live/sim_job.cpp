@@ -43,7 +43,7 @@ std::string SimJob::outDir() const {
 bool SimJob::start(const std::string& gale, const std::string& scene, const std::string& outDir,
                    const std::vector<SimObject>& objects, long firstFrame, long lastFrame,
                    std::string& error) {
-    stop();
+    stop(true);
     std::error_code ec;
     fs::create_directories(outDir, ec);
     if (ec) {
@@ -112,7 +112,9 @@ void SimJob::run() {
         const pid_t r = ::waitpid(mPid, &status, WNOHANG);
         exited = r == mPid || (r < 0 && errno != EINTR);
         if (!mStopping) poll();
-        if (!exited) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (!exited)
+            std::this_thread::sleep_for(
+                std::chrono::milliseconds(10)); // (frames seen within 10 ms)
     }
     if (!mStopping) poll();
     std::string tail;
@@ -134,7 +136,7 @@ void SimJob::run() {
     mOnExit(code, tail);
 }
 
-void SimJob::stop() {
+void SimJob::stop(bool now) {
     pid_t pid;
     {
         std::lock_guard<std::mutex> lock(mMutex);
@@ -142,7 +144,7 @@ void SimJob::stop() {
     }
     if (pid > 0) {
         mStopping = true;
-        ::kill(pid, SIGTERM);
+        ::kill(pid, now ? SIGKILL : SIGTERM);
         for (int i = 0; i < 100 && mRunning; ++i)
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
         std::lock_guard<std::mutex> lock(mMutex);

@@ -28,13 +28,14 @@ public:
     SimJob(const SimJob&) = delete;
     SimJob& operator=(const SimJob&) = delete;
 
-    // Stops any running child, then starts `gale sim scene -o outDir` (output and errors to
-    // outDir/sim.log). False with `error` when it cannot be started.
+    // Stops any running child (at once), then starts `gale sim scene -o outDir` (output and errors
+    // to outDir/sim.log). False with `error` when it cannot be started.
     bool start(const std::string& galeExecutable, const std::string& scene,
                const std::string& outDir, const std::vector<SimObject>& objects, long firstFrame,
                long lastFrame, std::string& error);
-    // SIGTERM to the child (SIGKILL after a second), waits for it and the thread.
-    void stop();
+    // SIGTERM to the child (SIGKILL after a second), waits for it and the thread. `now`:
+    // SIGKILL at once (a run an edit replaces: its folder is thrown away, nothing to finish).
+    void stop(bool now = false);
     bool running() const { return mRunning; }
     std::string outDir() const;
     const std::vector<SimObject>& objects() const { return mObjects; }

@@ -146,6 +146,25 @@ std::vector<std::string> SceneDocument::namedFiles() const {
     return out;
 }
 
+std::vector<std::string> SceneDocument::otherPaths() const {
+    std::vector<std::string> out;
+    const fs::path base = fs::path(m->path).parent_path();
+    auto walk = [&](const toml::node& n, auto&& self) -> void {
+        if (const auto* s = n.as_string()) {
+            const fs::path p = base / s->get();
+            std::error_code ec;
+            if (s->get().size() < 1000 && !s->get().empty() && !fs::is_regular_file(p, ec))
+                out.push_back(p.lexically_normal().string());
+        } else if (const auto* t = n.as_table()) {
+            for (const auto& kv : *t) self(kv.second, self);
+        } else if (const auto* a = n.as_array()) {
+            for (const auto& e : *a) self(e, self);
+        }
+    };
+    walk(m->root, walk);
+    return out;
+}
+
 std::optional<SourceSpan> SceneDocument::fieldParamLiteral(size_t field,
                                                            const std::string& name) const {
     const toml::array* fields = m->root["field"].as_array();

@@ -53,6 +53,10 @@ public:
     // Every string value that names an existing regular file relative to the scene's folder
     // (or absolute), in document order: what a watcher of the scene must also watch.
     std::vector<std::string> namedFiles() const;
+    // Every other string value (shorter than 1000 bytes) as a path relative to the scene's
+    // folder (or absolute), in document order: names of files that may appear later (a frame
+    // sequence `body/body.#.obj` whose folder is still to be written); the caller filters.
+    std::vector<std::string> otherPaths() const;
 
     // The literal of `[[field]]` number `field` (from 0) `params.NAME` when it is a number or
     // an array of numbers (a constant override a slider can rewrite in place); nullopt for

@@ -159,4 +159,11 @@ TEST_CASE("scene document: parameter literals and named files", "[scene][documen
     CHECK(files == std::vector<std::string>{d + "lift.se", d + "meshes/body.obj",
                                             d + "meshes/cape.obj", d + "meshes/cape.obj",
                                             d + "wind.se"});
+    // The other strings, as paths beside the scene: none of them an existing file.
+    for (const std::string& p : doc.otherPaths()) {
+        CHECK(p.rfind(d, 0) == 0);
+        CHECK(std::find(files.begin(), files.end(), p) == files.end());
+    }
+    const std::vector<std::string> other = doc.otherPaths();
+    CHECK(std::find(other.begin(), other.end(), d + "breeze") != other.end());
 }

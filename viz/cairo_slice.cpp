@@ -4,6 +4,7 @@
 // atomically, and contact sheets of thumbnails.
 #include "viz/cairo_painter.h"
 #include "viz/slice_marks.h"
+#include "viz/strain.h"
 
 #include "io/atomic_file.h"
 
@@ -171,7 +172,13 @@ void Painter::drawGeometry() {
                 c == 0 ? cairo_move_to(mCr, x, y) : cairo_line_to(mCr, x, y);
             }
             cairo_close_path(mCr);
-            setColor(mCr, {cloth.r * k, cloth.g * k, cloth.b * k});
+            Rgb col = cloth;
+            const std::vector<double>& strain = it.g->strain;
+            if (strain.size() == p.size()) // the triangle's largest-magnitude vertex strain
+                col = strainColour(std::max({strain[tri[0]], strain[tri[1]], strain[tri[2]]},
+                                            [](double a, double b) { return std::fabs(a) < std::fabs(b); }),
+                                   cloth);
+            setColor(mCr, {col.r * k, col.g * k, col.b * k});
             cairo_fill_preserve(mCr);
             cairo_set_line_width(mCr, 0.6);
             cairo_stroke(mCr);
@@ -180,7 +187,13 @@ void Painter::drawGeometry() {
             cairo_move_to(mCr, x, y);
             at(p[it.second], x, y);
             cairo_line_to(mCr, x, y);
-            setColor(mCr, {hair.r * (0.4 + k), hair.g * (0.4 + k), hair.b * (0.4 + k)});
+            Rgb col = hair;
+            const std::vector<double>& strain = it.g->strain;
+            if (strain.size() == p.size()) {
+                const double a = strain[it.index], b = strain[it.second];
+                col = strainColour(std::fabs(a) > std::fabs(b) ? a : b, hair);
+            }
+            setColor(mCr, {col.r * (0.4 + k), col.g * (0.4 + k), col.b * (0.4 + k)});
             cairo_set_line_width(mCr, std::max(1.0, 1.6 * mS));
             cairo_stroke(mCr);
         }

@@ -80,6 +80,8 @@ struct GeometryOverlay {
     std::vector<std::array<double, 3>> points;
     std::vector<std::array<int, 3>> triangles;
     std::vector<std::vector<int>> polylines;
+    // Per-vertex rest-relative strain (viz/strain.h); when present, drawn by strainColour.
+    std::vector<double> strain;
 };
 
 struct SliceOverlays {

@@ -9,7 +9,9 @@
 #include "scene/load.h"
 #include "scene/sim_scene.h"
 #include "viz/cairo_render.h"
+#include "viz/overlays.h"
 #include "viz/slice_marks.h"
+#include "viz/strain.h"
 
 #include <algorithm>
 #include <cctype>
@@ -263,6 +265,24 @@ int runVizFrames(const VizOptions& o) {
             g.label = name;
             geometry[f].push_back(std::move(g));
         }
+    }
+    if (o.strain) {
+        // The rest shapes the solver starts from (as gale live's); each frame's strain against
+        // them.
+        std::vector<std::unique_ptr<solver::Body>> bodies;
+        std::vector<std::string> warnings;
+        if (!scene::buildBodies(sim, bodies, errors, warnings, o.source.allowPaths)) {
+            for (const scene::SceneError& e : errors) std::cerr << e.render() << '\n';
+            return kExitInput;
+        }
+        std::vector<viz::GeometryOverlay> rest(bodies.size());
+        for (size_t k = 0; k < bodies.size(); ++k) {
+            std::istringstream obj(scene::bodyObjText(*bodies[k]));
+            viz::parseObjGeometry(obj, rest[k]);
+        }
+        for (auto& [f, gs] : geometry)
+            for (size_t k = 0; k < gs.size() && k < rest.size(); ++k)
+                gs[k].strain = viz::vertexStrain(rest[k], gs[k]);
     }
     for (auto& [f, gs] : geometry)
         for (const viz::GeometryOverlay& g : gs) all.push_back(&g);

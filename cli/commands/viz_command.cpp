@@ -242,6 +242,9 @@ Command addVizCommand(CLI::App& app) {
         ->type_name("WEDGEDIR");
     sub->add_flag("--no-field", o->noField, "With --frames: a plain backdrop instead of the field slice "
                                             "(the default for contact sheets)");
+    sub->add_flag("--strain", o->strain, "With --frames: colour the cloth and hair by strain (edge length "
+                                         "over rest length − 1: teal −25 %, the material's colour 0, "
+                                         "yellow, red +25 % and beyond; as gale live draws it)");
     sub->add_option("--cell", o->cell, "Contact sheet thumbnail size in pixels")
         ->type_name("WxH")
         ->capture_default_str();

@@ -2,7 +2,7 @@
 // Server-Sent Events (a file changed and recompiled, diagnostics, simulated frames) and wires
 // the controls. Every request carries the session token from the page's URL.
 import { View } from 'gale/view.js';
-import { renderParams, renderRamps, renderSource, renderLegend, draggable, Timeline, shortPath, fmt } from 'gale/panels.js';
+import { renderParams, renderRamps, renderSource, renderLegend, renderStrainLegend, renderRunEvents, draggable, Timeline, shortPath, fmt } from 'gale/panels.js';
 
 const token = new URLSearchParams(location.search).get('token') || '';
 const $ = (id) => document.getElementById(id);
@@ -15,11 +15,13 @@ async function api(path, body) {
   return j;
 }
 
-const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null });
+const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null });
 const view = new View($('view'));
+live.screenBox = (name) => view.screenBox(name);
+live.setTime = (t) => setTime(t);
 const timeline = new Timeline($('timeline'), (t) => setTime(t));
 let state = null, scene = null, fieldData = null, currentFile = null;
-let time = 0, playing = false, simFrames = [], shownFrame = null;
+let time = 0, playing = false, simFrames = [], shownFrame = null, simRun = 0, endedRun = null, previousRun = null;
 
 function sliceRequest() {
   const axis = Number($('sliceAxis').value);
@@ -124,6 +126,28 @@ async function refreshScene() {
   scene = await api('/api/scene');
   view.setBox(scene.box);
   view.setBodies(scene.rest, scene.colliders);
+  colliderShown = null;
+  showColliders(colliderWanted === null ? 0 : colliderWanted);
+}
+
+// The colliders at time t (the shown frame's time while a simulation's frame is shown): one
+// request in flight, the newest wish kept.
+let colliderWanted = null, colliderShown = null, colliderBusy = false;
+async function showColliders(t) {
+  colliderWanted = t;
+  if (!scene || !scene.colliders.length || colliderBusy || t === colliderShown) return;
+  colliderBusy = true;
+  try {
+    const c = await api('/api/colliders?t=' + t);
+    view.setColliderPoses(c.colliders);
+    colliderShown = t;
+    live.colliderTime = t;
+  } catch (e) {
+    live.errors.push(String(e.message || e));
+  } finally {
+    colliderBusy = false;
+    if (colliderWanted !== colliderShown) showColliders(colliderWanted);
+  }
 }
 
 function setTime(t) {
@@ -132,20 +156,84 @@ function setTime(t) {
   timeline.draw();
   $('timeText').textContent = `t = ${time.toFixed(3)} s · frame ${fmt(time * (state ? state.fps : 24), 1)}`;
   if (simFrames.length) showSimFrame(Math.round(time * state.fps));
+  else showColliders(time);
   refreshField();
 }
 
+// One frame request in flight; frames that arrive meanwhile are skipped to the newest wish.
+let frameObjects = [], frameBusy = false, frameWanted = null;
 async function showSimFrame(f) {
   const have = simFrames.filter((x) => x <= f);
   const n = have.length ? have[have.length - 1] : null;
   if (n === null || n === shownFrame) return;
+  if (frameBusy) { frameWanted = f; return; }
+  frameBusy = true;
   shownFrame = n;
+  showColliders(n / state.fps);
   try {
     const fr = await api('/api/frame?n=' + n);
-    view.setSimFrame(fr.objects);
-    live.simFrameShown = n;
+    if (fr.run === simRun) {
+      frameObjects = fr.objects;
+      drawSimFrame();
+      live.simFrameShown = n;
+      live.simFrameRun = fr.run;
+      showCompare(n);
+    } else {
+      shownFrame = null; // (a frame of a replaced run: ask again)
+    }
   } catch (e) {
     live.errors.push(String(e.message || e));
+    shownFrame = null;
+  } finally {
+    frameBusy = false;
+    if (frameWanted !== null) { const w = frameWanted; frameWanted = null; showSimFrame(w); }
+  }
+}
+
+// Compare: the same frame of the run the last edit replaced, over the shown one.
+async function showCompare(n) {
+  if (!$('showCompare').checked || !previousRun || n === null) {
+    view.setCompareFrame([]);
+    live.compareShown = null;
+    return;
+  }
+  try {
+    const fr = await api(`/api/frame?n=${n}&run=${previousRun}`);
+    if (shownFrame !== n) return;
+    view.setCompareFrame(fr.objects);
+    live.compareShown = { run: fr.run, frame: n };
+  } catch (e) {
+    view.setCompareFrame([]); // (that run did not reach frame n)
+    live.compareShown = null;
+  }
+}
+
+// The shown frame, coloured by strain when that is on (with its legend).
+function drawSimFrame(stale = false) {
+  const strain = $('showStrain').checked;
+  view.setSimFrame(frameObjects, { strain, stale });
+  const has = strain && !stale && frameObjects.some((o) => o.strain);
+  $('strainLegend').classList.toggle('hidden', !has);
+  live.strainShown = has;
+}
+
+// run.json's per-frame summary (/api/run) on the timeline and in the Run panel; at most one
+// request in flight, again when more frames came meanwhile.
+let runBusy = false, runAgain = false;
+async function refreshRun() {
+  if (runBusy) { runAgain = true; return; }
+  runBusy = true;
+  try {
+    const run = await api('/api/run');
+    timeline.run = run;
+    timeline.draw();
+    renderRunEvents($('runEvents'), run, (f) => setTime(f / state.fps));
+    live.run = run;
+  } catch (e) {
+    // (no simulation yet)
+  } finally {
+    runBusy = false;
+    if (runAgain) { runAgain = false; setTimeout(refreshRun, 300); }
   }
 }
 
@@ -168,6 +256,10 @@ function tick(now) {
 
 function events() {
   const es = new EventSource('/api/events?token=' + encodeURIComponent(token));
+  // (The tests read when each event arrived: [type, ms since the page loaded].)
+  live.events = [];
+  for (const type of ['field', 'diagnostics', 'frame', 'sim']) es.addEventListener(type, () => live.events.push([type, performance.now()]));
+  es.addEventListener('error', () => live.events.push(['error', performance.now()]));
   es.addEventListener('field', async () => {
     await refreshState();
     await refreshScene();
@@ -175,16 +267,39 @@ function events() {
   });
   es.addEventListener('diagnostics', () => refreshState());
   es.addEventListener('frame', (e) => {
-    const f = JSON.parse(e.data).frame;
+    const d = JSON.parse(e.data), f = d.frame;
+    if (d.run !== undefined && d.run !== simRun) return; // a frame of a run that was replaced
     simFrames.push(f);
     timeline.simFrames = simFrames;
-    $('simText').textContent = `frame ${f} of ${state.frames[1]}`;
+    $('simText').textContent = `frame ${f} of ${state.frames[1]}` + (simRun > 1 ? ` (run ${simRun})` : '');
+    live.framesOfRun = simFrames.length;
     if (!playing) setTime(f / state.fps);
+    refreshRun();
   });
   es.addEventListener('sim', (e) => {
     const s = JSON.parse(e.data);
-    $('simulate').textContent = s.running ? 'Stop' : 'Simulate';
-    if (!s.running) $('simText').textContent = s.exit === 0 ? `done: ${simFrames.length} frames` : s.exit === -1 ? 'stopped' : `gale sim failed (exit ${s.exit}): ` + (s.log || '').trim().split('\n').pop();
+    if (s.running && s.run !== undefined) {
+      if (s.restart) {
+        // An edit restarted the simulation: the old run's frames stay, greyed, until replaced.
+        timeline.staleFrames = [...new Set([...(timeline.staleFrames || []), ...simFrames])];
+        simFrames = [];
+        timeline.simFrames = simFrames;
+        timeline.run = null;
+        shownFrame = null;
+        drawSimFrame(true);
+        live.restarts = (live.restarts || 0) + 1;
+      }
+      simRun = s.run;
+      live.simRun = s.run;
+      previousRun = s.previous || null;
+    }
+    if (s.run !== undefined && s.run !== simRun) return;
+    $('simulate').textContent = s.running || s.on ? 'Stop' : 'Simulate';
+    if (!s.running) {
+      endedRun = s.run;
+      $('simText').textContent = s.exit === 0 ? `done: ${simFrames.length} frames` : s.exit === -1 ? 'stopped' : `gale sim failed (exit ${s.exit}): ` + (s.log || '').trim().split('\n').pop();
+      refreshRun();
+    }
   });
   es.onerror = () => { $('status').textContent = 'reconnecting…'; };
   es.onopen = () => { if (state) showStatus(); };
@@ -212,15 +327,24 @@ function wire() {
         simFrames = [];
         shownFrame = null;
         timeline.simFrames = simFrames;
-        view.setSimFrame([]);
+        timeline.staleFrames = [];
+        timeline.run = null;
+        frameObjects = [];
+        drawSimFrame();
       }
       const r = await api('/api/simulate', { action: running ? 'stop' : 'start' });
-      $('simulate').textContent = r.running ? 'Stop' : 'Simulate';
-      $('simText').textContent = r.running ? 'simulating…' : '';
+      // (A short run may have ended, and its event been shown, before this reply.)
+      if (r.run !== endedRun) {
+        $('simulate').textContent = r.running || r.on ? 'Stop' : 'Simulate';
+        $('simText').textContent = r.running ? 'simulating…' : '';
+      }
     } catch (e) {
       $('simText').textContent = String(e.message || e);
     }
   };
+  $('showStrain').onchange = () => drawSimFrame();
+  $('showCompare').onchange = () => showCompare(shownFrame);
+  renderStrainLegend($('strainBar'), $('strainTicks'));
   view.onRakeMoved = refreshField;
   draggable($('legend'));
   window.addEventListener('keydown', (e) => {

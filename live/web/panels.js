@@ -1,7 +1,7 @@
 // The side panels and bars of gale live: parameter sliders, ramp editors, the source with its
 // diagnostics inline, the speed legend and the gust timeline. Each calls back into app.js; none
 // talks to the server itself.
-import { colourAt } from 'gale/view.js';
+import { colourAt, strainColour, STRAIN_TOP, CLOTH_BASE } from 'gale/view.js';
 
 const el = (tag, attrs = {}, ...kids) => {
   const e = document.createElement(tag);
@@ -156,6 +156,37 @@ export function renderLegend(bar, ticks, maxText, map, top, max) {
   maxText.textContent = `max ${fmt(max, 2)} m/s` + (max > top ? ' (clipped)' : '');
 }
 
+// The strain legend: the map of viz/strain.h from −top (top of the bar: +top) with ticks.
+export function renderStrainLegend(bar, ticks) {
+  const g = bar.getContext('2d');
+  for (let y = 0; y < bar.height; ++y) {
+    const c = strainColour(STRAIN_TOP * (1 - 2 * y / (bar.height - 1)), CLOTH_BASE);
+    g.fillStyle = `rgb(${c.map((x) => Math.round(255 * x)).join(',')})`;
+    g.fillRect(0, y, bar.width, 1);
+  }
+  ticks.replaceChildren();
+  for (const v of [STRAIN_TOP, STRAIN_TOP / 2, 0, -STRAIN_TOP / 2, -STRAIN_TOP])
+    ticks.append(el('span', { style: `top:${(0.5 - v / (2 * STRAIN_TOP)) * 100}%` }, (v > 0 ? '+' : '') + fmt(100 * v, 1) + ' %'));
+}
+
+// The run's events (run.json), each at its frame; a click shows that frame.
+export function renderRunEvents(box, run, onPick) {
+  box.replaceChildren();
+  const rows = [];
+  for (const f of run.frames) {
+    const marks = [];
+    if (f.failed) marks.push('failed');
+    if (f.overStretched) marks.push(`over-stretched (${fmt(f.maxStretch, 2)}× rest)`);
+    if (f.halved) marks.push(`${f.halved} substep${f.halved === 1 ? '' : 's'} halved`);
+    if (f.recovered) marks.push(`${f.recovered} recovered`);
+    for (const e of f.events) marks.push(e);
+    if (marks.length) rows.push([f.frame, marks]);
+  }
+  if (!rows.length) box.append(el('p', { class: 'muted small' }, run.frames.length ? `no events in ${run.frames.length} frames` : 'no simulation yet'));
+  for (const [frame, marks] of rows)
+    box.append(el('div', { class: 'event small', onclick: () => onPick(frame) }, el('span', { class: 'frame' }, 'frame ' + frame), ' ' + marks.join(' · ')));
+}
+
 // Makes a floating panel draggable.
 export function draggable(node) {
   let start = null;
@@ -225,8 +256,20 @@ export class Timeline {
       if (tl.windicator && tl.windicator.length) curve(tl.windicator, '#6fa8ff');
       for (const cv of tl.gusts) curve(cv.points, '#ff8a3c');
     }
+    const fw = Math.max(1, X(1 / this.fps) - X(0));
+    g.fillStyle = '#6b7078'; // frames of a run an edit replaced, until the new run reaches them
+    for (const f of this.staleFrames || []) if (!this.simFrames.includes(f)) g.fillRect(X(f / this.fps), h - 3, fw, 3);
     g.fillStyle = '#5fd38a';
-    for (const f of this.simFrames) g.fillRect(X(f / this.fps), h - 3, Math.max(1, X(1 / this.fps) - X(0)), 3);
+    for (const f of this.simFrames) g.fillRect(X(f / this.fps), h - 3, fw, 3);
+    // The run's trouble per frame (run.json): contacts grey, halved or recovered substeps orange,
+    // over-stretched or failed red, and a white mark where an event was logged.
+    for (const f of (this.run && this.run.frames) || []) {
+      const x = X(f.frame / this.fps);
+      if (f.contacts) { g.fillStyle = '#9aa0a8'; g.fillRect(x, 2, fw, 3); }
+      if (f.halved || f.recovered) { g.fillStyle = '#f0a040'; g.fillRect(x, 6, fw, 4); }
+      if (f.overStretched || f.failed) { g.fillStyle = '#ff5050'; g.fillRect(x, 0, fw, h); }
+      if (f.events.length) { g.fillStyle = '#fff'; g.fillRect(x, 11, fw, 3); }
+    }
     g.strokeStyle = '#fff';
     g.beginPath();
     g.moveTo(X(this.t) + 0.5, 0);

@@ -13,6 +13,18 @@ export function colourAt(map, s) {
   return [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])];
 }
 
+// The strain colour map of viz/strain.h (strainColour), the same constants: `base` at 0,
+// yellow then red towards +top, teal towards −top, clamped beyond.
+export const STRAIN_TOP = 0.25;
+export function strainColour(strain, base, top = STRAIN_TOP) {
+  const s = Number.isFinite(strain) && top > 0 ? Math.min(1, Math.max(-1, strain / top)) : 0;
+  const mix = (a, b, w) => [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])];
+  const yellow = [0.98, 0.82, 0.22], red = [0.86, 0.12, 0.1], teal = [0.2, 0.82, 0.72];
+  if (s < 0) return mix(base, teal, -s);
+  return s < 0.5 ? mix(base, yellow, 2 * s) : mix(yellow, red, 2 * s - 1);
+}
+export const CLOTH_BASE = [0.42, 0.6, 0.86];
+
 export class View {
   constructor(canvas) {
     this.canvas = canvas;
@@ -30,7 +42,7 @@ export class View {
     sun.position.set(3, 5, 4);
     this.scene.add(sun);
     this.groups = {};
-    for (const name of ['slice', 'arrows', 'lines', 'rest', 'bodies', 'rigs', 'box', 'rake', 'sim']) {
+    for (const name of ['slice', 'arrows', 'lines', 'rest', 'bodies', 'rigs', 'box', 'rake', 'sim', 'compare']) {
       this.groups[name] = new THREE.Group();
       this.scene.add(this.groups[name]);
     }
@@ -189,14 +201,18 @@ export class View {
     this.groups.lines.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.85 })));
   }
 
+  // A mesh (and its wireframe) or polylines; returns the mesh, if any.
   geometry(group, g, colour) {
+    let mesh = null;
     if (g.triangles.length) {
       const geo = new THREE.BufferGeometry();
       geo.setAttribute('position', new THREE.Float32BufferAttribute(g.points, 3));
       geo.setIndex(g.triangles);
       geo.computeVertexNormals();
-      group.add(new THREE.Mesh(geo, new THREE.MeshStandardMaterial({ color: colour, side: THREE.DoubleSide, roughness: 0.7, transparent: true, opacity: 0.9 })));
+      mesh = new THREE.Mesh(geo, new THREE.MeshStandardMaterial({ color: colour, side: THREE.DoubleSide, roughness: 0.7, transparent: true, opacity: 0.9 }));
+      group.add(mesh);
       const wire = new THREE.LineSegments(new THREE.WireframeGeometry(geo), new THREE.LineBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.15 }));
+      mesh.userData.wire = wire;
       group.add(wire);
     }
     if (g.polylines.length) {
@@ -208,6 +224,7 @@ export class View {
       geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
       group.add(new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ color: 0xc08040 })));
     }
+    return mesh;
   }
 
   // Rest meshes of the cloth and hair, and the colliders.
@@ -216,37 +233,133 @@ export class View {
     this.clear('rest');
     const g = this.groups.bodies;
     for (const r of rest) this.geometry(this.groups.rest, r, 0x7fa8e8);
-    const mat = new THREE.MeshStandardMaterial({ color: 0x9aa0a8, roughness: 0.8, transparent: true, opacity: 0.55 });
+    this.colliders = [];
     for (const c of colliders) {
-      const a = new THREE.Vector3(...c.a), b = new THREE.Vector3(...c.b);
-      if (c.shape === 'sphere') {
-        const m = new THREE.Mesh(new THREE.SphereGeometry(c.radius, 32, 16), mat.clone());
-        m.position.copy(a);
-        g.add(m);
-      } else if (c.shape === 'capsule') {
-        const len = a.distanceTo(b);
-        const m = new THREE.Mesh(new THREE.CapsuleGeometry(c.radius, len, 8, 24), mat.clone());
-        m.position.copy(a).add(b).multiplyScalar(0.5);
-        m.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
-        g.add(m);
-      } else if (c.shape === 'plane') {
-        const n = new THREE.Vector3(...c.normal).normalize();
-        const size = this.box ? 2 * Math.max(...[0, 1, 2].map((k) => this.box.hi[k] - this.box.lo[k])) : 6;
-        const grid = new THREE.GridHelper(size, 20, 0x555b66, 0x30343c);
-        grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), n);
-        grid.position.copy(a);
-        g.add(grid);
-      } else if (c.mesh) {
-        this.geometry(g, c.mesh, 0x9aa0a8);
+      const entry = { shape: c.shape, name: c.name, object: null, radius: c.radius, length: null };
+      if (c.shape === 'mesh') {
+        if (c.mesh) entry.object = this.geometry(g, c.mesh, 0x9aa0a8);
+      } else {
+        this.placeCollider(entry, c);
       }
+      this.colliders.push(entry);
     }
   }
 
-  // Simulated frame geometry (replaces the rest meshes while shown).
-  setSimFrame(objects) {
+  // Puts an analytic collider's object where the pose says (made, or remade when a capsule's
+  // length or a radius changes).
+  placeCollider(entry, c) {
+    const g = this.groups.bodies;
+    const a = new THREE.Vector3(...c.a), b = new THREE.Vector3(...c.b);
+    const len = a.distanceTo(b);
+    const remake = !entry.object || entry.radius !== c.radius || (c.shape === 'capsule' && Math.abs(entry.length - len) > 1e-6);
+    if (remake && entry.object) {
+      g.remove(entry.object);
+      entry.object.traverse((o) => { if (o.geometry) o.geometry.dispose(); if (o.material) o.material.dispose(); });
+      entry.object = null;
+    }
+    const mat = () => new THREE.MeshStandardMaterial({ color: 0x9aa0a8, roughness: 0.8, transparent: true, opacity: 0.55 });
+    if (c.shape === 'sphere') {
+      if (!entry.object) entry.object = new THREE.Mesh(new THREE.SphereGeometry(c.radius, 32, 16), mat());
+      entry.object.position.copy(a);
+    } else if (c.shape === 'capsule') {
+      if (!entry.object) entry.object = new THREE.Mesh(new THREE.CapsuleGeometry(c.radius, len, 8, 24), mat());
+      entry.object.position.copy(a).add(b).multiplyScalar(0.5);
+      if (len > 0) entry.object.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
+    } else if (c.shape === 'plane') {
+      const n = new THREE.Vector3(...c.normal).normalize();
+      const size = this.box ? 2 * Math.max(...[0, 1, 2].map((k) => this.box.hi[k] - this.box.lo[k])) : 6;
+      if (!entry.object) entry.object = new THREE.GridHelper(size, 20, 0x555b66, 0x30343c);
+      entry.object.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), n);
+      entry.object.position.copy(a);
+    }
+    entry.radius = c.radius;
+    entry.length = len;
+    if (entry.object && !entry.object.parent) g.add(entry.object);
+  }
+
+  // The colliders at one time (/api/colliders): analytic ones moved, mesh sequences' vertices
+  // replaced (their triangles are those of /api/scene).
+  setColliderPoses(list) {
+    if (!this.colliders) return;
+    list.forEach((c, i) => {
+      const entry = this.colliders[i];
+      if (!entry || entry.name !== c.name) return;
+      if (c.shape !== 'mesh') {
+        this.placeCollider(entry, c);
+      } else if (c.points && entry.object) {
+        const geo = entry.object.geometry, pos = geo.getAttribute('position');
+        if (pos.array.length !== c.points.length) return;
+        pos.array.set(c.points);
+        pos.needsUpdate = true;
+        geo.computeVertexNormals();
+        geo.computeBoundingBox();
+        geo.computeBoundingSphere();
+        const wire = entry.object.userData.wire;
+        wire.geometry.dispose();
+        wire.geometry = new THREE.WireframeGeometry(geo);
+      }
+    });
+    this.render();
+  }
+
+  // The screen rectangle (canvas pixels: x0, y0, x1, y1) of a collider's current bounds.
+  screenBox(name) {
+    const entry = (this.colliders || []).find((c) => c.name === name);
+    const object = entry && entry.object ? entry.object : this.groups.sim.getObjectByName(name);
+    if (!object) return null;
+    const box = new THREE.Box3().setFromObject(object);
+    const w = this.canvas.width, h = this.canvas.height;
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (let k = 0; k < 8; ++k) {
+      const p = new THREE.Vector3(k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z).project(this.camera);
+      const x = (p.x + 1) / 2 * w, y = (1 - p.y) / 2 * h;
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+    return [Math.max(0, Math.floor(x0)), Math.max(0, Math.floor(y0)), Math.min(w, Math.ceil(x1)), Math.min(h, Math.ceil(y1))];
+  }
+
+  // Simulated frame geometry (replaces the rest meshes while shown): coloured by strain (per
+  // vertex, from /api/frame) when `strain` is on; grey when `stale` (a run an edit replaced).
+  setSimFrame(objects, { strain = this.strainOn, stale = false } = {}) {
     this.clear('sim');
-    for (const o of objects) this.geometry(this.groups.sim, o, 0x8fc0ff);
+    this.simObjects = objects;
+    this.strainOn = strain;
+    for (const o of objects) {
+      const mesh = this.geometry(this.groups.sim, o, stale ? 0x808080 : 0x8fc0ff);
+      if (mesh) mesh.name = o.label;
+      if (mesh && strain && !stale && o.strain && o.strain.length * 3 === o.points.length) {
+        const col = new Float32Array(o.points.length);
+        o.strain.forEach((x, i) => col.set(strainColour(x, CLOTH_BASE), 3 * i));
+        mesh.geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
+        mesh.material.vertexColors = true;
+        mesh.material.color.set(0xffffff);
+        mesh.material.needsUpdate = true;
+      }
+    }
     this.groups.rest.visible = objects.length === 0 && this.groups.bodies.visible;
+    this.render();
+  }
+
+  // Another run's frame over the shown one (compare): its cloth as an orange wireframe, its
+  // hair as orange lines; nothing for an empty list.
+  setCompareFrame(objects) {
+    this.clear('compare');
+    const mat = new THREE.LineBasicMaterial({ color: 0xff9a3c, transparent: true, opacity: 0.8 });
+    for (const o of objects) {
+      const pos = [];
+      const P = o.points;
+      const seg = (i, j) => pos.push(P[3 * i], P[3 * i + 1], P[3 * i + 2], P[3 * j], P[3 * j + 1], P[3 * j + 2]);
+      for (let k = 0; k + 2 < o.triangles.length; k += 3) {
+        const [a, b, c] = [o.triangles[k], o.triangles[k + 1], o.triangles[k + 2]];
+        seg(a, b); seg(b, c); seg(c, a);
+      }
+      for (const line of o.polylines) for (let k = 0; k + 1 < line.length; ++k) seg(line[k], line[k + 1]);
+      const geo = new THREE.BufferGeometry();
+      geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+      const lines = new THREE.LineSegments(geo, mat.clone());
+      lines.name = 'compare:' + o.label;
+      this.groups.compare.add(lines);
+    }
     this.render();
   }
 

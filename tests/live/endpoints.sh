@@ -147,6 +147,17 @@ get "$(tok /api/scene)"
 expect "$(json '[r["label"] for r in d["rest"]], len(d["rest"][0]["points"]), [c["shape"] for c in d["colliders"]]')" \
     "(['cape'], 1152, ['capsule'])" "the cape's rest mesh (16 x 24 vertices, 3 numbers each) and the capsule"
 
+# ---- colliders at a time ----
+get "$(tok "/api/colliders?t=0.5")"
+expect "$CODE" 200 "colliders at t = 0.5"
+expect "$(json '[(c["name"], c["shape"], c["moving"], "points" in c) for c in d["colliders"]], d["t"]')" \
+    "([('body', 'capsule', False, False)], 0.5)" "the ice cape's capsule, not a mesh sequence"
+get "$(tok "/api/colliders?t=abc")"
+expect "$CODE" 400 "colliders at a time that is not a number"
+get "$(tok /api/run)"
+expect "$CODE" 404 "no run yet"
+is_error_json "no run yet"
+
 # ---- events: an edit, a syntax error, the fix ----
 curl -sN "$(printf '%s/api/events?token=%s' "$BASE" "$TOKEN")" > "$TMP/events" &
 CURL_PID=$!
@@ -170,6 +181,13 @@ for _ in $(seq 100); do [ "$(grep -c '^event: field' "$TMP/events")" -ge 2 ] && 
 get "$(tok /api/state)"
 expect "$(json 'd["ok"]')" True "fixed again"
 kill "$CURL_PID"; wait "$CURL_PID" 2>/dev/null
+# A reconnecting EventSource sends Last-Event-ID: the events after it are sent again at once.
+first_id=$(grep -m1 '^id: ' "$TMP/events" | cut -d' ' -f2)
+timeout 2 curl -sN -H "Last-Event-ID: $first_id" "$(printf '%s/api/events?token=%s' "$BASE" "$TOKEN")" > "$TMP/resumed"
+expect "$(grep -c '^id: ' "$TMP/resumed")" "$(($(grep -c '^id: ' "$TMP/events") - 1))" "Last-Event-ID $first_id resumes after it"
+get "$(tok /api/state)"
+for _ in $(seq 50); do [ "$(json 'd["eventStreams"]')" = 0 ] && break; sleep 0.05; get "$(tok /api/state)"; done
+expect "$(json 'd["eventStreams"]')" 0 "the closed streams are freed"
 
 # ---- simulate ----
 sed -i 's/^frames = \[1, 72\]/frames = [1, 6]/' "$TOML"
@@ -183,6 +201,11 @@ expect "$CODE" 200 "frame 6"
 expect "$(json '[o["label"] for o in d["objects"]], len(d["objects"][0]["points"])')" "(['cape'], 1152)" "frame 6's cape"
 get "$(tok "/api/frame?n=99")"
 expect "$CODE" 404 "a frame not written"
+get "$(tok "/api/frame?n=1")"
+expect "$(json '[max(abs(x) for x in o["strain"]) for o in d["objects"]], len(d["objects"][0]["strain"]) * 3 == len(d["objects"][0]["points"])')" \
+    "([0.0], True)" "frame 1 is the rest shape: no strain, one value per vertex"
+for _ in $(seq 50); do get "$(tok /api/run)"; [ "$(json 'd["status"]')" = ok ] && break; sleep 0.1; done
+expect "$(json 'd["status"], [f["frame"] for f in d["frames"]], d["overStretch"]')" "('ok', [1, 2, 3, 4, 5, 6], 3.0)" "run.json's frames"
 sed -i 's/^frames = \[1, 6\]/frames = [1, 2000]/' "$TOML"
 sleep 0.3
 post /api/simulate '{"action": "start"}'
