@@ -49,11 +49,13 @@ std::string stepJson(const solver::StepOptions& s) {
 
 std::string settingsJson(const scene::SimScene& sc,
                          const std::vector<std::unique_ptr<Body>>& bodies, int first, int last,
-                         int threads) {
+                         int threads, const std::vector<std::string>& sets) {
     const fields::SceneSettings& s = sc.wind.settings;
     const double t0 = s.frameTime(first);
     std::ostringstream o;
-    o << "{\"scene\": " << jsonString(sc.wind.path) << ", \"fps\": " << num(s.fps)
+    o << "{\"scene\": " << jsonString(sc.wind.path) << ", \"sets\": [";
+    for (size_t i = 0; i < sets.size(); ++i) o << (i ? ", " : "") << jsonString(sets[i]);
+    o << "], \"fps\": " << num(s.fps) << ", \"time_zero\": " << num(s.timeZero)
       << ", \"frames\": [" << first << ", " << last << "], \"substeps\": " << s.substeps
       << ", \"gravity\": " << vec(s.gravity) << ", \"air_density\": " << num(s.airDensity)
       << ", \"threads\": " << threads

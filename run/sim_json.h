@@ -14,9 +14,11 @@ namespace gale::run {
 
 // The settings as resolved (after --set) for frames first..last, run.json's "settings" (and
 // what --resume compares to continue only the same run).
+// `sets` are the --set overrides as given (recorded so that `gale viz --sim` can draw the scene
+// the run used).
 std::string settingsJson(const scene::SimScene& scene,
                          const std::vector<std::unique_ptr<solver::Body>>& bodies, int first,
-                         int last, int threads);
+                         int last, int threads, const std::vector<std::string>& sets = {});
 
 // One frame's statistics, an element of run.json's "frames".
 std::string frameJson(const solver::FrameStats& stats);

@@ -121,7 +121,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
         err.message = s.scene + ": the scene has no [[cloth]] or [[hair]] to simulate";
         return err;
     }
-    mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads);
+    mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads, s.sets);
     mInputs = digestInputs(mScene, s.sets);
     for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast))
         report += w.render() + '\n';

@@ -156,7 +156,7 @@ void Painter::drawGeometry() {
     clipToPlot();
     cairo_set_line_join(mCr, CAIRO_LINE_JOIN_ROUND);
     cairo_set_line_cap(mCr, CAIRO_LINE_CAP_ROUND);
-    const Rgb cloth{0.42, 0.6, 0.86}, hair{0.62, 0.42, 0.2};
+    const Rgb cloth{0.42, 0.6, 0.86}, hair{0.62, 0.42, 0.2}, bodyGrey{0.72, 0.72, 0.7};
     auto at = [&](const std::array<double, 3>& q, double& x, double& y) {
         x = pxOfU(q[u]);
         y = pyOfV(q[v]);
@@ -172,13 +172,17 @@ void Painter::drawGeometry() {
                 c == 0 ? cairo_move_to(mCr, x, y) : cairo_line_to(mCr, x, y);
             }
             cairo_close_path(mCr);
-            Rgb col = cloth;
+            Rgb col = it.g->body ? bodyGrey : cloth;
             const std::vector<double>& strain = it.g->strain;
             if (strain.size() == p.size()) // the triangle's largest-magnitude vertex strain
                 col = strainColour(std::max({strain[tri[0]], strain[tri[1]], strain[tri[2]]},
                                             [](double a, double b) { return std::fabs(a) < std::fabs(b); }),
                                    cloth);
             setColor(mCr, {col.r * k, col.g * k, col.b * k});
+            if (it.g->body) { // a body: filled, no mesh lines (dense bodies would turn black)
+                cairo_fill(mCr);
+                continue;
+            }
             cairo_fill_preserve(mCr);
             cairo_set_line_width(mCr, 0.6);
             cairo_stroke(mCr);

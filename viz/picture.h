@@ -82,6 +82,8 @@ struct GeometryOverlay {
     std::vector<std::vector<int>> polylines;
     // Per-vertex rest-relative strain (viz/strain.h); when present, drawn by strainColour.
     std::vector<double> strain;
+    // A collider's surface (a moving body at the frame), drawn grey, not as cloth.
+    bool body = false;
 };
 
 struct SliceOverlays {

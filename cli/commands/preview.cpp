@@ -8,6 +8,7 @@
 #include "fields/grid_sample.h"
 #include "scene/load.h"
 #include "scene/sim_scene.h"
+#include "solver/collider/moving_collider.h"
 #include "viz/cairo_render.h"
 #include "viz/overlays.h"
 #include "viz/slice_marks.h"
@@ -25,9 +26,24 @@
 #include <map>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 namespace gale::cli {
 
 namespace {
+
+// The --set overrides a run recorded in DIR/run.json (settings.sets), or none.
+std::vector<std::string> recordedSets(const std::string& dir) {
+    std::ifstream in(std::filesystem::path(dir) / "run.json");
+    if (!in) return {};
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    std::vector<std::string> sets;
+    if (j.is_object() && j.contains("settings") && j["settings"].contains("sets") &&
+        j["settings"]["sets"].is_array())
+        for (const auto& s : j["settings"]["sets"])
+            if (s.is_string()) sets.push_back(s.get<std::string>());
+    return sets;
+}
 
 namespace fs = std::filesystem;
 
@@ -237,11 +253,22 @@ int runVizFrames(const VizOptions& o) {
     int uAxis = 0, vAxis = 1;
     viz::planeAxes(normal, uAxis, vAxis);
 
+    // The scene as the run used it: the run's own --set overrides (run.json) first, then any
+    // given here.
+    const std::string dir = o.sim.empty() ? "sim" : o.sim;
+    SourceOptions source = o.source;
+    const std::vector<std::string> runSets = recordedSets(dir);
+    if (!runSets.empty()) {
+        std::cerr << "gale: drawing the scene with the run's overrides:";
+        for (const std::string& s : runSets) std::cerr << " --set " << s;
+        std::cerr << '\n';
+        source.sets.insert(source.sets.begin(), runSets.begin(), runSets.end());
+    }
     FieldInput input;
-    if (int rc = loadFieldInput(o.source, o.fps, input)) return rc;
+    if (int rc = loadFieldInput(source, o.fps, input)) return rc;
     scene::SimScene sim;
     std::vector<scene::SceneError> errors;
-    if (!gale::scene::loadSimScene(o.source.file, sim, errors, o.source.sets)) {
+    if (!gale::scene::loadSimScene(source.file, sim, errors, source.sets)) {
         for (const scene::SceneError& e : errors) std::cerr << e.render() << '\n';
         return kExitInput;
     }
@@ -252,7 +279,6 @@ int runVizFrames(const VizOptions& o) {
         printError(o.source.file + ": the scene has no [[cloth]] or [[hair]] to draw");
         return kExitInput;
     }
-    const std::string dir = o.sim.empty() ? "sim" : o.sim;
     std::map<long, std::vector<viz::GeometryOverlay>> geometry;
     std::vector<const viz::GeometryOverlay*> all;
     for (long f : frames) {
@@ -283,6 +309,21 @@ int runVizFrames(const VizOptions& o) {
         for (auto& [f, gs] : geometry)
             for (size_t k = 0; k < gs.size() && k < rest.size(); ++k)
                 gs[k].strain = viz::vertexStrain(rest[k], gs[k]);
+    }
+    // The moving bodies (mesh-sequence colliders) at each frame's time, as the solver saw them.
+    for (const solver::Collider& c : sim.colliders) {
+        if (!c.moving) continue;
+        const solver::MeshSequence& seq = c.moving->mesh();
+        for (long f : frames) {
+            viz::GeometryOverlay g;
+            g.label = c.name;
+            g.body = true;
+            std::vector<double> x;
+            seq.positionsAt(input.frameTime(static_cast<double>(f)), x);
+            for (size_t i = 0; i + 2 < x.size(); i += 3) g.points.push_back({x[i], x[i + 1], x[i + 2]});
+            g.triangles = seq.triangles();
+            geometry[f].push_back(std::move(g));
+        }
     }
     for (auto& [f, gs] : geometry)
         for (const viz::GeometryOverlay& g : gs) all.push_back(&g);

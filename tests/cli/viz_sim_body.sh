@@ -1,0 +1,47 @@
+# gale viz --sim draws what the run used: the moving body (a mesh-sequence collider) at each
+# frame's time, grey, and the scene with the run's own --set overrides (recorded in run.json).
+source "$(dirname "$0")/lib.bash" "$@"
+
+mkdir -p cache
+for ((f = 0; f <= 8; f++)); do
+    awk -v x=$(awk -v k=$f 'BEGIN { printf "%.6f", k * 0.05 }') 'BEGIN {
+        split("-0.2 0.2", X); split("0.2 0.5", Y); split("-0.2 0.2", Z)
+        for (i = 1; i <= 2; i++) for (j = 1; j <= 2; j++) for (k = 1; k <= 2; k++)
+            printf "v %.6f %.6f %.6f\n", X[i] + x, Y[j], Z[k]
+        print "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4" }' > cache/body.$(printf %04d $f).obj
+done
+cat > scene.toml <<'EOF2'
+[scene]
+frames = [0, 8]
+substeps = 2
+
+[windicator]
+direction = [0, 0, 1]
+speed = 2
+
+[[cloth]]
+name = "sheet"
+grid = { size = [0.6, 0.6], res = [8, 8], origin = [-0.3, 0.6, -0.3], axes = "xz" }
+pins = { box = [-0.31, 0.59, -0.31, 0.31, 0.61, -0.29] }
+
+[[collider]]
+name = "box"
+type = "mesh"
+mesh = "cache/body.####.obj"
+EOF2
+run "$GALE" sim scene.toml -o out --set windicator.speed=6
+expect_rc 0 "the run"
+expect_match "$(head -c 300 out/run.json)" '"sets": \["windicator.speed=6"\]' "run.json records the overrides"
+
+run "$GALE" viz scene.toml --sim out --frames 2,8 --plane y=1 --style none --no-field -o 'p.#.svg' --size 320x320
+expect_rc 0 "pictures of two frames"
+expect_match "$ERR" "with the run's overrides: --set windicator.speed=6" "the run's overrides are applied again ($ERR)"
+# Fills whose red and green parts are equal are the body's grey; the cloth is blue.
+greys() { grep -o 'fill="rgb([0-9.]*%,[0-9.]*%,[0-9.]*%)"' "$1" | awk -F'[(,%]' '$2 == $4 { n++ } END { print n + 0 }'; }
+for f in 0002 0008; do
+    [ "$(greys p.$f.svg)" -gt 0 ] || fail "frame $f draws the body"
+done
+# The body moved 0.3 m along +x between the frames: so did its picture.
+cmp -s <(grep -o 'fill="rgb([0-9.]*%,[0-9.]*%,[0-9.]*%)"' p.0002.svg) <(grep -o 'fill="rgb([0-9.]*%,[0-9.]*%,[0-9.]*%)"' p.0008.svg) &&
+    cmp -s p.0002.svg p.0008.svg && fail "the body is drawn where it is at each frame"
+finish
