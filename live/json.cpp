@@ -51,6 +51,7 @@ json stateJson(const Project& p, double time) {
     s["files"] = p.files();
     s["time"] = time;
     s["fps"] = p.fps();
+    s["timeZero"] = p.timeZero();
     s["frames"] = json::array({p.frameStart(), p.frameEnd()});
     json diags = json::array();
     for (const Diagnostic& d : p.diagnostics())

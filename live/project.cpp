@@ -264,6 +264,7 @@ void Project::loadSceneFile() {
     if (!loaded) return;
     auto scene = std::make_shared<fields::Scene>(sim.wind);
     mFps = scene->settings.fps > 0 ? scene->settings.fps : 24.0;
+    mTimeZero = scene->settings.timeZero;
     mFrameStart = scene->settings.frameStart;
     mFrameEnd = scene->settings.frameEnd;
     mScene = scene;
@@ -292,7 +293,8 @@ void Project::loadSceneFile() {
                 lp.editable = false;
                 // A constant number (or array of numbers) in `params = { name = ... }`.
                 const std::optional<gale::scene::SourceSpan> span =
-                    parsed && !over->second.isKeyed() ? doc.fieldParamLiteral(i, p.name) : std::nullopt;
+                    parsed && !over->second.isKeyed() ? doc.fieldParamLiteral(i, p.name)
+                                                      : std::nullopt;
                 if (span) {
                     lp.file = mInput;
                     lp.literal.line = span->line;
@@ -377,10 +379,10 @@ void Project::computeBox() {
             const long n = static_cast<long>(seq.frameCount());
             std::vector<double> x;
             for (long k = 0; k < n; k += std::max(1L, n / 8)) {
-                seq.positionsAt(static_cast<double>(seq.firstFrame() + k) / seq.fps(), x);
+                seq.positionsAt(seq.frameTime(static_cast<double>(seq.firstFrame() + k)), x);
                 for (size_t i = 0; i + 2 < x.size(); i += 3) grow({x[i], x[i + 1], x[i + 2]}, 0.0);
             }
-            seq.positionsAt(static_cast<double>(seq.firstFrame() + n - 1) / seq.fps(), x);
+            seq.positionsAt(seq.frameTime(static_cast<double>(seq.lastFrame())), x);
             for (size_t i = 0; i + 2 < x.size(); i += 3) grow({x[i], x[i + 1], x[i + 2]}, 0.0);
         }
     if (!(hi[0] >= lo[0])) {

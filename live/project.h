@@ -80,6 +80,8 @@ public:
     fields::FieldPtr field() const { return mField; }
     std::shared_ptr<const fields::Scene> scene() const { return mScene; }
     double fps() const { return mFps; }
+    // scene.time_zero: frame F is at t = (F − timeZero) / fps (0 for a lone .se).
+    double timeZero() const { return mTimeZero; }
     int frameStart() const { return mFrameStart; }
     int frameEnd() const { return mFrameEnd; }
     const std::vector<viz::GeometryOverlay>& restGeometry() const { return mRest; }
@@ -121,6 +123,7 @@ private:
     fields::FieldPtr mField;
     std::shared_ptr<const fields::Scene> mScene;
     double mFps = 24.0;
+    double mTimeZero = 0.0;
     int mFrameStart = 1, mFrameEnd = 48;
     std::vector<viz::GeometryOverlay> mRest;
     std::vector<ColliderShape> mColliders;

@@ -90,3 +90,38 @@ radius = 0.25
     CHECK(std::find(patterns.begin(), patterns.end(),
                     (s.dir / "seq/tri.#.obj").lexically_normal().string()) != patterns.end());
 }
+
+TEST_CASE("project: with scene.time_zero, frame F of a sequence is at (F - time_zero) / fps") {
+    Scratch s;
+    s.write("seq/tri.1001.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    s.write("seq/tri.1002.obj", "v 2 0 0\nv 3 0 0\nv 2 1 0\nf 1 2 3\n");
+    s.write("wind.se", "[1, 0, 0]\n");
+    s.write("scene.toml", R"([scene]
+fps = 24
+time_zero = 1001
+frames = [1001, 1004]
+
+[[field]]
+name = "w"
+expr = "wind.se"
+
+[[cloth]]
+name = "c"
+grid = { size = [0.2, 0.2], res = [2, 2], origin = [0, 2, 0], axes = "xy" }
+
+[[collider]]
+name = "tri"
+type = "mesh"
+mesh = "seq/tri.#.obj"
+)");
+    Project p((s.dir / "scene.toml").string());
+    REQUIRE(p.load());
+    CHECK(p.timeZero() == 1001);
+    for (double t : {0.0, 0.25 / 24, 0.5 / 24, 1.0 / 24, 2.0 / 24}) {
+        const std::vector<ColliderShape> c = p.collidersAt(t);
+        REQUIRE(c.size() == 1);
+        REQUIRE(c[0].mesh.points.size() == 3);
+        const double w = std::clamp(t * 24, 0.0, 1.0); // frame 1001 at 0 s, 1002 at 1/24 s
+        CHECK(c[0].mesh.points[0][0] == Approx(2 * w).margin(1e-12));
+    }
+}

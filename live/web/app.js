@@ -54,7 +54,7 @@ async function refreshField() {
     renderLegend($('legendBar'), $('legendTicks'), $('legendMax'), map, s.top, s.max);
     const w = fieldData.overlays.windicator;
     $('windicator').textContent = w.present ? `windicator ${fmt(w.speed, 2)} m/s → [${w.direction.map((c) => fmt(c, 2)).join(', ')}]` : '';
-    timeline.set(fieldData.overlays.timeline, state.fps, state.frames);
+    timeline.set(fieldData.overlays.timeline, state.fps, state.frames, state.timeZero || 0);
     live.fieldUpdates++;
     live.lastFieldMs = { fetch: t1 - t0, draw: performance.now() - t1 };
   } catch (e) {
@@ -150,12 +150,16 @@ async function showColliders(t) {
   }
 }
 
+// Frame F is at t = (F − time_zero) / fps (the scene's [scene] time_zero), and back.
+const frameTime = (f) => (f - (state ? state.timeZero || 0 : 0)) / (state ? state.fps : 24);
+const frameAt = (t) => t * (state ? state.fps : 24) + (state ? state.timeZero || 0 : 0);
+
 function setTime(t) {
   time = Math.max(0, t);
   timeline.t = time;
   timeline.draw();
-  $('timeText').textContent = `t = ${time.toFixed(3)} s · frame ${fmt(time * (state ? state.fps : 24), 1)}`;
-  if (simFrames.length) showSimFrame(Math.round(time * state.fps));
+  $('timeText').textContent = `t = ${time.toFixed(3)} s · frame ${fmt(frameAt(time), 1)}`;
+  if (simFrames.length) showSimFrame(Math.round(frameAt(time)));
   else showColliders(time);
   refreshField();
 }
@@ -169,7 +173,7 @@ async function showSimFrame(f) {
   if (frameBusy) { frameWanted = f; return; }
   frameBusy = true;
   shownFrame = n;
-  showColliders(n / state.fps);
+  showColliders(frameTime(n));
   try {
     const fr = await api('/api/frame?n=' + n);
     if (fr.run === simRun) {
@@ -227,7 +231,7 @@ async function refreshRun() {
     const run = await api('/api/run');
     timeline.run = run;
     timeline.draw();
-    renderRunEvents($('runEvents'), run, (f) => setTime(f / state.fps));
+    renderRunEvents($('runEvents'), run, (f) => setTime(frameTime(f)));
     live.run = run;
   } catch (e) {
     // (no simulation yet)
@@ -273,7 +277,7 @@ function events() {
     timeline.simFrames = simFrames;
     $('simText').textContent = `frame ${f} of ${state.frames[1]}` + (simRun > 1 ? ` (run ${simRun})` : '');
     live.framesOfRun = simFrames.length;
-    if (!playing) setTime(f / state.fps);
+    if (!playing) setTime(frameTime(f));
     refreshRun();
   });
   es.addEventListener('sim', (e) => {

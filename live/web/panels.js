@@ -225,10 +225,11 @@ export class Timeline {
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 
-  set(timeline, fps, frames) {
+  set(timeline, fps, frames, timeZero = 0) {
     this.fps = fps;
+    this.timeZero = timeZero;
     this.data = timeline;
-    const end = frames ? frames[1] / fps : 2;
+    const end = frames ? (frames[1] - timeZero) / fps : 2;
     this.range = timeline && timeline.present ? [timeline.t0, timeline.t1] : [0, Math.max(end, 1)];
     this.draw();
   }
@@ -258,13 +259,14 @@ export class Timeline {
     }
     const fw = Math.max(1, X(1 / this.fps) - X(0));
     g.fillStyle = '#6b7078'; // frames of a run an edit replaced, until the new run reaches them
-    for (const f of this.staleFrames || []) if (!this.simFrames.includes(f)) g.fillRect(X(f / this.fps), h - 3, fw, 3);
+    const T = (f) => (f - (this.timeZero || 0)) / this.fps; // frame f's time
+    for (const f of this.staleFrames || []) if (!this.simFrames.includes(f)) g.fillRect(X(T(f)), h - 3, fw, 3);
     g.fillStyle = '#5fd38a';
-    for (const f of this.simFrames) g.fillRect(X(f / this.fps), h - 3, fw, 3);
+    for (const f of this.simFrames) g.fillRect(X(T(f)), h - 3, fw, 3);
     // The run's trouble per frame (run.json): contacts grey, halved or recovered substeps orange,
     // over-stretched or failed red, and a white mark where an event was logged.
     for (const f of (this.run && this.run.frames) || []) {
-      const x = X(f.frame / this.fps);
+      const x = X(T(f.frame));
       if (f.contacts) { g.fillStyle = '#9aa0a8'; g.fillRect(x, 2, fw, 3); }
       if (f.halved || f.recovered) { g.fillStyle = '#f0a040'; g.fillRect(x, 6, fw, 4); }
       if (f.overStretched || f.failed) { g.fillStyle = '#ff5050'; g.fillRect(x, 0, fw, h); }
