@@ -110,8 +110,8 @@ struct SimScene {
 // the scene that named them; `warnings` gets notes such as degenerate-triangle counts. Files
 // named in painted-map expressions resolve like the wind's: inside the scene's folder or one of
 // `allowPaths` (--allow-path).
-// Attachments bind against their body at the first simulated frame's time, firstFrame / fps
-// (the start state's time; INT_MIN: the scene's first frame), whatever range the sequence covers.
+// Attachments bind against their body at the first simulated frame's time (the start state's:
+// frameTime(firstFrame); INT_MIN: the scene's first frame), whatever range the sequence covers.
 bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<solver::Body>>& bodies,
                  std::vector<SceneError>& errors, std::vector<std::string>& warnings,
                  const std::vector<std::string>& allowPaths = {}, int firstFrame = INT_MIN);
