@@ -272,7 +272,7 @@ SampleStatus ExpressionField::sampleWith(const double* positions, size_t count,
     request.threads = when.threads;
     request.varyings.push_back({"P", 3, positions, 3, 1});
     request.uniforms.push_back({"t", {when.time}, {}});
-    request.uniforms.push_back({"frame", {when.time * when.fps}, {}});
+    request.uniforms.push_back({"frame", {when.time * when.fps + when.frameZero}, {}});
     request.uniforms.push_back({"fps", {when.fps}, {}});
     for (size_t i = 0; i < mParameters.size(); ++i)
         request.uniforms.push_back({mParameters[i].name, mValues[i].at(when.time), {}});

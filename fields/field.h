@@ -18,7 +18,8 @@ using Vec3 = std::array<double, 3>;
 // When (and how) a batch is sampled.
 struct SampleTime {
     double time = 0.0;  // seconds ($t)
-    double fps = 24.0;  // frames per second ($fps); $frame = time * fps
+    double fps = 24.0;  // frames per second ($fps); $frame = time * fps + frameZero
+    double frameZero = 0.0; // the frame at time 0 (scene.time_zero)
     int substep = 0;    // substep index within the frame (informational)
     int threads = 1;    // threads the field may use for this batch (0: all)
 };

@@ -20,6 +20,11 @@ struct SceneSettings {
     int substeps = 4; // minimum per frame
     std::vector<double> gravity{0.0, -9.81, 0.0};
     double airDensity = 1.225;
+    // scene.time_zero: the frame at which $t = 0 (studio shots start at 1001): $t, wind and
+    // gust keys and mesh sequences are shot time, $frame the studio frame number.
+    double timeZero = 0.0;
+    // Seconds at `frame` (the end of that frame's step).
+    double frameTime(double frame) const { return (frame - timeZero) / fps; }
 };
 
 // The continuity rig: a direction arrow with an animatable intensity. Expressions see it as

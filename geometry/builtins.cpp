@@ -465,8 +465,8 @@ bool validateMeshVel(lang::CallSite& site) {
     if (!ref) return false;
     if (!ref->sequence) {
         site.sink->error(site.argSpans[0],
-                         "meshvel() needs a per-frame mesh sequence with a '#' for the frame "
-                         "number (\"body.#.obj\"); '" +
+                         "meshvel() needs a per-frame mesh sequence with a frame number (\"body.#.obj\", "
+                         "\"body.%04d.obj\" or \"body.$F4.obj\"); '" +
                              ref->name + "' is one mesh, which does not move");
         return false;
     }

@@ -3,6 +3,8 @@
 // frame sequences found by scanning their folder, and the per-file cache keys.
 #include "geometry/file_policy.h"
 
+#include "io/frame_pattern.h"
+
 #include "io/grid.h"
 
 #include <algorithm>
@@ -50,6 +52,7 @@ bool inside(const fs::path& p, const fs::path& dir) {
 // Whether the canonical `target` is inside the root or an allowed folder; `allowedOnly` skips
 // the root (absolute names must be inside an --allow-path folder).
 bool permitted(const FileAccess& access, const fs::path& target, bool allowedOnly) {
+    if (!access.sandboxed) return true;
     if (!allowedOnly) {
         // The folder names resolve in (the expression's) and the root (a scene's folder).
         if (inside(target, canonicalOf(absoluteDir(access.baseDir)))) return true;
@@ -82,9 +85,7 @@ bool fileKey(const fs::path& canonical, std::string& key, std::string& error) {
     return true;
 }
 
-bool hasHashRun(const std::string& s) {
-    return s.find('#') != std::string::npos;
-}
+bool hasHashRun(const std::string& s) { return io::hasFrameToken(s); }
 
 } // namespace
 
@@ -133,8 +134,8 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
     const std::string file = p.filename().string();
     if (hasHashRun(p.parent_path().string())) {
         error = "'" + name +
-                "': a '#' frame number may only appear in the file name, not in a "
-                "folder";
+                "': a frame number (" + io::kFrameTokens +
+                ") may only appear in the file name, not in a folder";
         return false;
     }
     std::error_code ec;
@@ -160,17 +161,10 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         out = std::move(ref);
         return true;
     }
-    // A sequence: one run of '#'.
-    std::string probe;
-    if (!io::framePath(file, 0, probe)) {
-        error = "'" + name + "' has more than one run of '#'; a sequence has one (wind.#.vdb)";
-        return false;
-    }
+    // A sequence: one frame token ('#' run, %04d, $F4).
+    io::FramePattern pattern;
+    if (!io::parseFramePattern(file, pattern, &error)) return false;
     ref.sequence = true;
-    const size_t first = file.find('#');
-    const size_t end = file.find_first_not_of('#', first);
-    const std::string prefix = file.substr(0, first);
-    const std::string suffix = end == std::string::npos ? std::string() : file.substr(end);
     const fs::path dir = p.parent_path();
     fs::directory_iterator it(dir, ec);
     if (ec) {
@@ -180,19 +174,8 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
     for (; it != fs::directory_iterator(); it.increment(ec)) {
         if (ec) break;
         const std::string entry = it->path().filename().string();
-        if (entry.size() <= prefix.size() + suffix.size()) continue;
-        if (entry.compare(0, prefix.size(), prefix) != 0) continue;
-        if (entry.compare(entry.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
-        const std::string middle =
-            entry.substr(prefix.size(), entry.size() - prefix.size() - suffix.size());
-        const size_t digits0 = middle[0] == '-' ? 1 : 0;
-        if (middle.size() <= digits0 || middle.size() > 12 ||
-            !std::all_of(middle.begin() + static_cast<long>(digits0), middle.end(),
-                         [](char c) { return c >= '0' && c <= '9'; }))
-            continue;
-        const long frame = std::stol(middle);
-        std::string expected;
-        if (!io::framePath(file, frame, expected) || expected != entry) continue; // other padding
+        long frame = 0;
+        if (!io::matchFrame(pattern, entry, frame)) continue; // another name, or other padding
         std::error_code sec;
         if (!fs::is_regular_file(it->path(), sec)) continue;
         const fs::path canonical = canonicalOf(it->path());
@@ -212,10 +195,9 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         ref.frames.push_back(std::move(f));
     }
     if (ref.frames.empty()) {
-        std::string example;
-        io::framePath(file, 1, example);
-        error = "no files of the sequence '" + name + "' in " + dir.string() +
-                " (frame 1 would be " + example + ")";
+        error = "no files of the sequence '" + name + "' in " + dir.string() + " (frame 1 would be " +
+                io::formatFrame(pattern, 1) + "; frame numbers are written as " + io::kFrameTokens +
+                ")";
         return false;
     }
     std::sort(ref.frames.begin(), ref.frames.end(),

@@ -13,6 +13,10 @@ struct FileAccess {
     std::string baseDir;              // names resolve against this folder ("": the current one)
     std::string rootDir;              // and must stay inside it or this one (a scene's folder)
     std::vector<std::string> allowed; // --allow-path folders: anything inside them is allowed
+    // False for files named by scene keys (a collider's or attachment's mesh sequence): the
+    // user's own choice, not sandboxed (docs/limits.md), so frame files may be symbolic links
+    // to a cache anywhere.
+    bool sandboxed = true;
 };
 
 // Access for an expression read from `sourceFile`: its folder (the current folder for "", "-"

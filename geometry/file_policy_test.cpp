@@ -169,7 +169,7 @@ TEST_CASE("`#` sequences: frames found with their padding, picked by frame", "[g
 
     CHECK(errorOf(a, "gust.#.vdb").find("no files of the sequence 'gust.#.vdb'") !=
           std::string::npos);
-    CHECK(errorOf(a, "a.#.#.vdb").find("more than one run") != std::string::npos);
+    CHECK(errorOf(a, "a.#.#.vdb").find("more than one frame number") != std::string::npos);
     // A frame that is a link out of the folder is refused.
     fs::create_symlink(t.root / "outside" / "secret.obj", t.root / "shot" / "wind.0009.vdb");
     CHECK(errorOf(a, "wind.#.vdb").find("leads outside") != std::string::npos);

@@ -217,19 +217,4 @@ IoError writeGridFile(const std::string& path, GridFormat format, const GridSpec
     });
 }
 
-bool framePath(const std::string& pattern, long frame, std::string& out) {
-    const size_t first = pattern.find('#');
-    if (first == std::string::npos) return false;
-    size_t end = pattern.find_first_not_of('#', first);
-    if (end == std::string::npos) end = pattern.size();
-    if (pattern.find('#', end) != std::string::npos) return false;
-    const size_t run = end - first;
-    const size_t width = run == 1 ? 4 : run;
-    std::string digits = std::to_string(frame < 0 ? -frame : frame);
-    if (digits.size() < width) digits.insert(0, width - digits.size(), '0');
-    if (frame < 0) digits.insert(0, 1, '-');
-    out = pattern.substr(0, first) + digits + pattern.substr(end);
-    return true;
-}
-
 } // namespace gale::io

@@ -69,9 +69,10 @@ IoError writeGridCsv(std::ostream& out, const GridSpec& grid, const std::vector<
 IoError writeGridFile(const std::string& path, GridFormat format, const GridSpec& grid,
                       const std::vector<float>& values);
 
-// `pattern` with its one run of '#' replaced by the frame number, zero-padded to the run's
-// length, or to 4 digits for a single '#' (`wind.#.vdb` -> `wind.0012.vdb`, `v.##.npy` ->
-// `v.12.npy`, frame -3 -> `-0003`). False when the name has no '#' run or more than one.
+// `pattern` with its one frame token replaced by the frame number (io/frame_pattern.h): a run
+// of '#' zero-padded to the run's length, or to 4 digits for a single '#' (`wind.#.vdb` ->
+// `wind.0012.vdb`, `v.##.npy` -> `v.12.npy`, frame -3 -> `-0003`), `%04d`, `$F4`. False when the
+// name has no token or more than one.
 bool framePath(const std::string& pattern, long frame, std::string& out);
 
 } // namespace gale::io

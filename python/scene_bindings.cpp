@@ -81,7 +81,14 @@ public:
         if (mFailed || mNext > mSim->last()) throw py::stop_iteration();
         solver::FrameStats stats;
         if (mNext == mSim->first()) {
-            stats = mSim->initialFrame();
+            // A range after the scene's first frame starts from the simulated state there
+            // (run/sim_run.h, the run-up), as `gale sim --frames` does.
+            bool ranUp = true;
+            {
+                py::gil_scoped_release release;
+                ranUp = mSim->runUp({}, stats);
+            }
+            if (ranUp) stats = mSim->initialFrame();
         } else {
             py::gil_scoped_release release;
             stats = mSim->advance(mNext);
@@ -180,7 +187,8 @@ public:
             raise(ErrorKind::Argument, "t and frame must be finite numbers");
         fields::SampleTime when;
         when.fps = mWind.settings.fps;
-        when.time = t ? *t : frame ? *frame / when.fps : 0.0;
+        when.frameZero = mWind.settings.timeZero;
+        when.time = t ? *t : frame ? mWind.settings.frameTime(*frame) : 0.0;
         fields::GridSampleOptions options;
         options.threads = threads;
         std::vector<float> out;

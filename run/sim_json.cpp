@@ -51,7 +51,7 @@ std::string settingsJson(const scene::SimScene& sc,
                          const std::vector<std::unique_ptr<Body>>& bodies, int first, int last,
                          int threads) {
     const fields::SceneSettings& s = sc.wind.settings;
-    const double t0 = first / s.fps;
+    const double t0 = s.frameTime(first);
     std::ostringstream o;
     o << "{\"scene\": " << jsonString(sc.wind.path) << ", \"fps\": " << num(s.fps)
       << ", \"frames\": [" << first << ", " << last << "], \"substeps\": " << s.substeps
@@ -172,10 +172,10 @@ std::string frameJson(const solver::FrameStats& f) {
     return o.str();
 }
 
-solver::FrameStats initialStats(const solver::World& w, int frame, double fps) {
+solver::FrameStats initialStats(const solver::World& w, int frame, double t) {
     solver::FrameStats f;
     f.frame = frame;
-    f.time = frame / fps;
+    f.time = t;
     for (const auto& b : w.bodies()) {
         solver::BodyFrameStats s;
         s.name = b->name();

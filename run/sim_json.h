@@ -21,7 +21,7 @@ std::string settingsJson(const scene::SimScene& scene,
 // One frame's statistics, an element of run.json's "frames".
 std::string frameJson(const solver::FrameStats& stats);
 
-// The frame's stats of the initial state (no substeps taken) at `frame` (t = frame / fps).
-solver::FrameStats initialStats(const solver::World& world, int frame, double fps);
+// The frame's stats of the initial state (no substeps taken) at `frame`, time `t` (s).
+solver::FrameStats initialStats(const solver::World& world, int frame, double t);
 
 } // namespace gale::run

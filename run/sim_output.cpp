@@ -29,6 +29,17 @@ std::string stateFile(const std::string& dir, int frame, const char* ext) {
     return (fs::path(dir) / ".state" / buf).string();
 }
 
+// Settings text with its thread count blanked ("threads": N is the one key that changes no
+// result).
+std::string withoutThreads(const std::string& settings) {
+    const std::string key = "\"threads\": ";
+    const size_t at = settings.find(key);
+    if (at == std::string::npos) return settings;
+    size_t end = at + key.size();
+    while (end < settings.size() && settings[end] >= '0' && settings[end] <= '9') ++end;
+    return settings.substr(0, at + key.size()) + settings.substr(end);
+}
+
 bool readFile(const std::string& path, std::string& out) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return false;
@@ -120,15 +131,25 @@ RunError SimOutput::open(SimRun& run, const OutputOptions& o, std::vector<std::s
     // --resume: the last frame whose state and stats were saved, by this same run.
     mNext = first;
     if (o.resume) {
-        std::string saved;
+        std::string saved, inputs;
+        // The thread count changes no result: a run may resume on another machine.
         if (readFile((fs::path(o.dir) / ".state" / "settings.json").string(), saved) &&
-            saved != run.settings()) {
+            withoutThreads(saved) != withoutThreads(run.settings())) {
             RunError e;
             e.kind = RunError::Input;
             e.message =
                 o.dir +
                 ": the saved run has different settings (scene, --set or --frames changed); "
                 "run without --resume to start over";
+            return e;
+        }
+        if (readFile((fs::path(o.dir) / ".state" / "inputs.txt").string(), inputs) &&
+            inputs != run.inputsDigest()) {
+            RunError e;
+            e.kind = RunError::Input;
+            e.message = o.dir +
+                        ": the scene's inputs changed since the saved run (the scene file, an "
+                        "expression, a mesh or a sequence); run without --resume to start over";
             return e;
         }
         int resumeAt = -1;
@@ -178,6 +199,9 @@ RunError SimOutput::open(SimRun& run, const OutputOptions& o, std::vector<std::s
                     return ioError(e.render());
         }
     }
+    if (RunError e =
+            writeBytes((fs::path(o.dir) / ".state" / "inputs.txt").string(), run.inputsDigest()))
+        return e;
     return writeBytes((fs::path(o.dir) / ".state" / "settings.json").string(), run.settings());
 }
 

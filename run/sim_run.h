@@ -7,6 +7,7 @@
 #include "scene/sim_scene.h"
 #include "solver/world/world.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -48,8 +49,23 @@ public:
     double fps() const { return mScene.wind.settings.fps; }
     // run.json's "settings": the scene as resolved, for this frame range and thread count.
     const std::string& settings() const { return mSettings; }
+    // A digest of what the run reads besides its settings — the scene file's text, the --set
+    // overrides, the expression files (their bytes), meshes, strands and attachment sequences
+    // (their sizes and times) — so that --resume refuses a run whose inputs changed since.
+    const std::string& inputsDigest() const { return mInputs; }
     // The output format ("obj" or "ply") of the world's body `i`.
     const std::string& outputFormat(size_t i) const;
+
+    // The frames simulated before first() and not written (the run-up): a range that starts
+    // after the scene's first frame is reached by simulating from there, so that it starts from a
+    // simulated state — the cloth where the shot took it — never from the rest mesh teleported
+    // to the bodies' pose at first(). 0 when first() is the scene's first frame (or before it).
+    int runUpFrames() const { return mFirst - mRunUpFrom; }
+    // Steps the world from the scene's first frame to first(), calling `each` after every frame
+    // (for progress and events). False, with the frame's stats in `failed`, when a frame failed
+    // numerically.
+    bool runUp(const std::function<void(const solver::FrameStats&)>& each,
+               solver::FrameStats& failed);
 
     // The stats of frame first(): the initial state, no substeps.
     solver::FrameStats initialFrame() const;
@@ -60,7 +76,9 @@ private:
     scene::SimScene mScene;
     std::unique_ptr<solver::World> mWorld;
     int mFirst = 0, mLast = 0;
+    int mRunUpFrom = 0; // the frame the run-up starts at (its initial state)
     std::string mSettings;
+    std::string mInputs;
 };
 
 } // namespace gale::run

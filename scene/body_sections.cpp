@@ -1,6 +1,7 @@
 // The scene loader's body sections: [[cloth]], [[hair]], [[collider]] and [solver], read from
 // the parsed scene after the wind sections (scene/load.cpp). --set overrides are applied to the TOML tree by dotted
 // path first; then every key is checked and converted, every problem reported at file:line:col.
+#include "io/frame_pattern.h"
 #include "scene/load.h"
 #include "scene/sections.h"
 #include "scene/toml_reader.h"
@@ -74,7 +75,8 @@ private:
 
     void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
     void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
-    void loadCollider(const toml::table& t, size_t index, double fps, Collider& c);
+    void loadCollider(const toml::table& t, size_t index, const fields::SceneSettings& settings,
+                      Collider& c);
     void loadSolver(const toml::table& t, SolverSection& s);
 };
 
@@ -579,8 +581,11 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
     stepOptions(t, what, h.step, h.output);
 }
 
-void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collider& c) {
+void Loader::loadCollider(const toml::table& t, size_t index, const fields::SceneSettings& settings,
+                          Collider& c) {
     c.name = "collider" + std::to_string(index);
+    c.line = static_cast<int>(t.source().begin.line);
+    c.col = static_cast<int>(t.source().begin.column);
     if (const toml::node* n = t.get("name")) string(*n, "[[collider]] name", c.name);
     const std::string what = "[[collider]] '" + c.name + "'";
     checkKeys(t, kColliderKeys, "[[collider]]");
@@ -633,10 +638,10 @@ void Loader::loadCollider(const toml::table& t, size_t index, double fps, Collid
     const std::string path = p.is_absolute() ? file
                              : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
     std::string problem;
-    if (path.find('#') != std::string::npos) {
-        // A per-frame sequence: triangles, a refitted tree and continuous contact
+    if (io::hasFrameToken(path)) {
+        // A per-frame sequence ('#' run, %04d or $F4): triangles, a refitted tree and continuous contact
         // (solver/collider/moving_collider.h) instead of an SDF rebuilt every frame.
-        std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, fps, problem);
+        std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, settings.fps, problem, settings.timeZero);
         if (!seq) {
             error(*mesh, what + ": " + problem);
             return;
@@ -689,7 +694,7 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
     });
     list("collider", [&](const toml::table& t, size_t i) {
         Collider c;
-        loadCollider(t, i, out.wind.settings.fps, c);
+        loadCollider(t, i, out.wind.settings, c);
         out.colliders.push_back(std::move(c));
     });
     if (const toml::node* n = root.get("solver")) {

@@ -2,12 +2,30 @@
 // caret under the column, then notes.
 #include "scene/error.h"
 
+#include <fstream>
+
 namespace gale::scene {
+
+SceneError sceneErrorAt(const std::string& file, int line, int col, std::string message) {
+    SceneError e;
+    e.file = file;
+    e.line = line;
+    e.col = col;
+    e.message = std::move(message);
+    if (line > 0) {
+        std::ifstream in(file);
+        std::string text;
+        for (int i = 0; i < line && std::getline(in, text); ++i) {
+        }
+        e.sourceLine = text;
+    }
+    return e;
+}
 
 std::string SceneError::render() const {
     std::string out = file.empty() ? std::string("<scene>") : file;
     if (line > 0) out += ":" + std::to_string(line) + ":" + std::to_string(col > 0 ? col : 1);
-    out += ": error: " + message;
+    out += (warning ? ": warning: " : ": error: ") + message;
     if (line > 0 && !sourceLine.empty()) {
         out += "\n    ";
         for (char c : sourceLine) out += (static_cast<unsigned char>(c) < 0x20 && c != '\t') ? ' ' : c;

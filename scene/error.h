@@ -16,9 +16,14 @@ struct SceneError {
     std::vector<std::string> notes; // extra lines ("did you mean", the declared parameters)
     std::string sourceLine;         // the offending line of the file, when known
     bool io = false;                // a file could not be read (the CLI exits 3, not 1)
-    // "file:line:col: error: message" (without :line:col when line is 0), then the source line
+    bool warning = false;           // a likely mistake that does not stop a run
+    // "file:line:col: error: message" ("warning:" for a warning; without :line:col when line is
+    // 0), then the source line
     // with a caret under the column, then "note: ..." lines.
     std::string render() const;
 };
+
+// An error at file:line:col of `file`, its source line read from the file.
+SceneError sceneErrorAt(const std::string& file, int line, int col, std::string message);
 
 } // namespace gale::scene

@@ -18,6 +18,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <tuple>
 
 namespace gale::scene {
 
@@ -26,19 +27,7 @@ using namespace gale::solver;
 namespace {
 
 SceneError sceneError(const SimScene& scene, int line, int col, std::string message) {
-    SceneError e;
-    e.file = scene.wind.path;
-    e.line = line;
-    e.col = col;
-    e.message = std::move(message);
-    if (line > 0) {
-        std::ifstream in(scene.wind.path);
-        std::string text;
-        for (int i = 0; i < line && std::getline(in, text); ++i) {
-        }
-        e.sourceLine = text;
-    }
-    return e;
+    return sceneErrorAt(scene.wind.path, line, col, std::move(message));
 }
 
 Vec3 axisOf(char c) {
@@ -127,7 +116,9 @@ bool evaluateMap(const SimScene& scene, const PaintedSpec& spec, const std::stri
     }
     runtime::EvalRequest req;
     req.count = n;
-    req.uniforms = {{"t", {0.0}, ""}, {"frame", {0.0}, ""}, {"fps", {scene.wind.settings.fps}, ""}};
+    req.uniforms = {{"t", {0.0}, ""},
+                    {"frame", {scene.wind.settings.timeZero}, ""},
+                    {"fps", {scene.wind.settings.fps}, ""}};
     req.varyings = {
         {"P", 3, positions.data(), 3, 1}, {"u", 1, u.data(), 1, 1}, {"v", 1, v.data(), 1, 1}};
     values.assign(n, 0.0);
@@ -200,14 +191,16 @@ bool selectVertices(const SimScene& scene, const PinSpec& spec, const std::strin
 }
 
 // Sequences named by several keys (a collider and an attachment) are read once per build.
-std::shared_ptr<const MeshSequence> loadSequence(const std::string& path, double fps,
+std::shared_ptr<const MeshSequence> loadSequence(const std::string& path,
+                                                 const fields::SceneSettings& settings,
                                                  std::string& error) {
-    static std::map<std::pair<std::string, double>, std::weak_ptr<const MeshSequence>> cache;
+    static std::map<std::tuple<std::string, double, double>, std::weak_ptr<const MeshSequence>> cache;
     static std::mutex lock;
     std::lock_guard<std::mutex> g(lock);
-    auto& slot = cache[{path, fps}];
+    auto& slot = cache[{path, settings.fps, settings.timeZero}];
     if (auto s = slot.lock()) return s;
-    std::shared_ptr<const MeshSequence> s = MeshSequence::load(path, fps, error);
+    std::shared_ptr<const MeshSequence> s =
+        MeshSequence::load(path, settings.fps, error, settings.timeZero);
     slot = s;
     return s;
 }
@@ -218,6 +211,7 @@ WorldSettings worldSettings(const SimScene& scene, int threads) {
     WorldSettings ws;
     const fields::SceneSettings& s = scene.wind.settings;
     ws.fps = s.fps;
+    ws.timeZero = s.timeZero;
     ws.substeps = s.substeps;
     ws.maxHalvings = scene.solver.maxHalvings;
     if (s.gravity.size() >= 3) ws.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
@@ -357,7 +351,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         if (spec.hasAttach) {
             PinSet att;
             std::string problem;
-            att.attach = loadSequence(spec.attachMesh, scene.wind.settings.fps, problem);
+            att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));
@@ -426,7 +420,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         std::vector<int> otherRoots;
         if (spec.hasAttach) {
             std::string problem;
-            att.attach = loadSequence(spec.attachMesh, scene.wind.settings.fps, problem);
+            att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));

@@ -136,7 +136,7 @@ void Loader::verbatimPosition(const toml::node& n, const std::string& value, int
 // ---- Sections ---------------------------------------------------------------------------------
 
 void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
-    checkKeys(t, {"fps", "frames", "substeps", "gravity", "air_density"}, "[scene]");
+    checkKeys(t, {"fps", "frames", "substeps", "gravity", "air_density", "time_zero"}, "[scene]");
     if (const toml::node* n = t.get("fps")) {
         double v = 0.0;
         if (number(*n, "scene.fps", v)) {
@@ -162,6 +162,15 @@ void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
                 s.frameStart = static_cast<int>(first);
                 s.frameEnd = static_cast<int>(last);
             }
+        }
+    }
+    if (const toml::node* n = t.get("time_zero")) {
+        double v = 0.0;
+        if (number(*n, "scene.time_zero (the frame at which $t = 0)", v)) {
+            if (std::fabs(v) <= 100000000.0)
+                s.timeZero = v;
+            else
+                error(*n, "scene.time_zero must stay within +/-100000000 (a frame number)");
         }
     }
     if (const toml::node* n = t.get("substeps")) {

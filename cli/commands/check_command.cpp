@@ -1,12 +1,16 @@
 // `gale check FILE.se...`: parse and type-check expression files (or -e EXPR) and print every
-// diagnostic with its source line and caret. A SCENE.toml is loaded and every [[field]] of it
-// compiled. Exit 1 if any has an error, 3 if one is unreadable.
+// diagnostic with its source line and caret. A SCENE.toml is loaded whole — every [[field]]
+// compiled, and the cloth, hair and colliders built as `gale sim` builds them (meshes, sequences,
+// painted maps, pins) — so a scene that checks clean also loads for a run. Exit 1 if any has an
+// error, 3 if one is unreadable.
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/commands/field_input.h"
 #include "fields/expression_field.h"
 #include "fields/scene.h"
 #include "scene/load.h"
+#include "scene/scene_checks.h"
+#include "scene/sim_scene.h"
 
 #include <CLI/CLI.hpp>
 
@@ -18,27 +22,36 @@ namespace gale::cli {
 
 namespace {
 
-// Loads a scene (with --set applied by dotted path) and compiles every field; returns an exit
-// code after printing every problem.
+// Prints scene errors; the exit code they call for (3 when a file could not be read).
+int reportSceneErrors(const std::vector<scene::SceneError>& errors) {
+    bool io = false;
+    for (const scene::SceneError& e : errors) {
+        std::cerr << e.render() << '\n';
+        io = io || e.io;
+    }
+    std::cerr << std::flush;
+    return io ? kExitIo : kExitInput;
+}
+
+// Loads a scene (with --set applied by dotted path), compiles every field and builds its bodies
+// as a run would; returns an exit code after printing every problem.
 int checkScene(const std::string& path, const std::vector<std::string>& sets,
                const std::vector<std::string>& allowPaths) {
-    fields::Scene scene;
+    gale::scene::SimScene sim;
     std::vector<scene::SceneError> errors;
-    gale::scene::SceneLoadOptions options;
-    options.sets = sets;
-    if (!gale::scene::loadScene(path, scene, errors, options)) {
-        bool io = false;
-        for (const scene::SceneError& e : errors) {
-            std::cerr << e.render() << '\n';
-            io = io || e.io;
-        }
-        std::cerr << std::flush;
-        return io ? kExitIo : kExitInput;
-    }
+    if (!gale::scene::loadSimScene(path, sim, errors, sets)) return reportSceneErrors(errors);
     std::string report;
     fields::FieldPtr field =
-        fields::buildSceneField(scene, runtime::Precision::Float, report, useColor(), allowPaths);
+        fields::buildSceneField(sim.wind, runtime::Precision::Float, report, useColor(), allowPaths);
     if (!report.empty()) std::cerr << report << std::flush;
+    std::vector<std::unique_ptr<solver::Body>> bodies;
+    std::vector<std::string> warnings;
+    const bool built = gale::scene::buildBodies(sim, bodies, errors, warnings, allowPaths);
+    for (const std::string& w : warnings) std::cerr << "gale: warning: " << w << '\n';
+    if (!built) return reportSceneErrors(errors);
+    for (const scene::SceneError& w : gale::scene::runWarnings(
+             sim, bodies, sim.wind.settings.frameStart, sim.wind.settings.frameEnd))
+        std::cerr << w.render() << '\n';
     return field ? kExitOk : kExitInput;
 }
 

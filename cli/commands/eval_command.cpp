@@ -317,7 +317,8 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints, io::Point
     const double fps = fpsGiven ? o.fps : scene.settings.fps;
     fields::SampleTime when;
     when.fps = fps;
-    when.time = o.hasTime ? o.time : o.hasFrame ? o.frame / fps : 0.0;
+    when.frameZero = scene.settings.timeZero;
+    when.time = o.hasTime ? o.time : o.hasFrame ? (o.frame - scene.settings.timeZero) / fps : 0.0;
     when.threads = o.threads >= 0 ? o.threads : havePoints ? 0 : 1;
     if (havePoints && streamsPoints(o, format)) {
         PointStream stream;

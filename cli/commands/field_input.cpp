@@ -158,6 +158,7 @@ int loadFieldInput(const SourceOptions& source, double fpsOverride, FieldInput& 
     int rc = scene ? loadSceneInput(source, out) : loadExpression(source, out);
     if (rc) return rc;
     out.fps = fpsOverride > 0 ? fpsOverride : out.scene ? out.scene->settings.fps : 24.0;
+    out.timeZero = out.scene ? out.scene->settings.timeZero : 0.0;
     return kExitOk;
 }
 

@@ -21,6 +21,9 @@ struct FieldInput {
     std::string name; // for titles and metadata: the file as given, or "<expr>"
     // Frames per second: --fps, else the scene's, else 24.
     double fps = 24.0;
+    // The scene's time_zero (the frame at t = 0), else 0: frame F is at (F − timeZero) / fps.
+    double timeZero = 0.0;
+    double frameTime(double frame) const { return (frame - timeZero) / fps; }
 };
 
 // True for a path naming a scene file (.toml, any case).

@@ -273,7 +273,7 @@ int runVizFrames(const VizOptions& o) {
     }
 
     for (long f : frames) {
-        const double t = f / input.fps;
+        const double t = input.frameTime(static_cast<double>(f));
         viz::SliceOverlays overlays;
         if (input.scene) overlays = viz::sceneOverlays(*input.scene, t);
         overlays.geometry = geometry[f];

@@ -5,6 +5,7 @@
 #include "cli/commands/field_input.h"
 #include "fields/grid_sample.h"
 #include "geometry/vdb_io.h"
+#include "io/frame_pattern.h"
 
 #include <CLI/CLI.hpp>
 
@@ -100,20 +101,12 @@ int writeOutput(const SampleOptions& o, const std::string& path, io::GridFormat 
 void removeStaleFrameTemps(const std::string& pattern) {
     namespace fs = std::filesystem;
     const fs::path p(pattern);
-    const std::string folder = p.parent_path().string(), name = p.filename().string();
-    const size_t first = name.find('#');
-    if (first == std::string::npos || folder.find('#') != std::string::npos) return;
-    const size_t end = name.find_first_not_of('#', first);
-    const std::string head = name.substr(0, first), tail = end == std::string::npos ? "" : name.substr(end);
+    const std::string folder = p.parent_path().string();
+    io::FramePattern fp;
+    if (io::hasFrameToken(folder) || !io::parseFramePattern(p.filename().string(), fp)) return;
     io::removeStaleTempFiles(folder, [&](const std::string& target) {
-        if (target.size() <= head.size() + tail.size() || target.compare(0, head.size(), head) != 0 ||
-            target.compare(target.size() - tail.size(), tail.size(), tail) != 0)
-            return false;
-        const std::string middle = target.substr(head.size(), target.size() - head.size() - tail.size());
-        for (size_t i = 0; i < middle.size(); ++i)
-            if (!std::isdigit(static_cast<unsigned char>(middle[i])) && !(i == 0 && middle[i] == '-'))
-                return false;
-        return true;
+        long frame = 0;
+        return io::matchFrame(fp, target, frame);
     });
 }
 
@@ -218,9 +211,11 @@ int runSample(const SampleOptions& o) {
         }
         fields::SampleTime when;
         when.fps = input.fps;
-        when.time = frames ? static_cast<double>(f) / input.fps : o.time;
+        when.frameZero = input.timeZero;
+        when.time = frames ? input.frameTime(static_cast<double>(f)) : o.time;
         when.threads = o.threads;
-        const double frameNumber = frames ? static_cast<double>(f) : when.time * input.fps;
+        const double frameNumber =
+            frames ? static_cast<double>(f) : when.time * input.fps + input.timeZero;
         const std::string label =
             frames ? "frame " + std::to_string(f) + " (" + std::to_string(n + 1) + "/" +
                          std::to_string(count) + ")"

@@ -104,6 +104,25 @@ int runSim(const SimOptions& o) {
     if (opened) return show(opened);
 
     const int first = sim.first(), last = sim.last();
+    if (out.nextFrame() == first && sim.runUpFrames() > 0) {
+        // A range that starts mid-shot starts from the simulated state there, not a teleport.
+        const int from = first - sim.runUpFrames();
+        std::cerr << "gale: frames " << from << "-" << first
+                  << " are simulated first and not written: frame " << first
+                  << " starts from a simulated state\n";
+        Progress runUp(sim.runUpFrames());
+        int step = 0;
+        solver::FrameStats failed;
+        if (!sim.runUp([&](const solver::FrameStats&) { runUp.update(++step, from + step); },
+                       failed)) {
+            runUp.finish();
+            printError("frame " + std::to_string(failed.frame) +
+                       " (before the range): the run failed numerically (non-finite state that "
+                       "halving the substep could not fix)");
+            return kExitNumeric;
+        }
+        runUp.finish();
+    }
     Progress progress(last - first + 1);
     if (out.nextFrame() == first)
         if (run::RunError e = out.saveFrame(sim.initialFrame())) return show(e);
@@ -156,8 +175,9 @@ Command addSimCommand(CLI::App& app) {
         ->required();
     sub->add_option("-o,--output", o->output, "Output folder (default: sim)")->type_name("OUTDIR");
     sub->add_option("--frames", o->frames,
-                    "Frames A to B (inclusive) instead of the scene's; frame A is the "
-                    "initial state at t = A / fps")
+                    "Frames A to B (inclusive) instead of the scene's. Frame A is the initial "
+                    "state; when A is after the scene's first frame, the frames before it are "
+                    "simulated first (not written), so A starts from a simulated state")
         ->type_name("A:B");
     sub->add_option(
            "--set", o->sets,

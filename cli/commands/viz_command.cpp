@@ -80,6 +80,7 @@ int sampleSlice(const FieldInput& input, double t, int threads, viz::Slice& slic
     fields::SampleTime when;
     when.time = t;
     when.fps = input.fps;
+    when.frameZero = input.timeZero;
     when.threads = threads;
     const size_t n = static_cast<size_t>(slice.nu) * static_cast<size_t>(slice.nv);
     const fields::SampleStatus status = viz::sampleSlice(*input.field, when, slice);
@@ -171,7 +172,8 @@ int runViz(const VizOptions& o) {
     settings.title = input.name;
     settings.subtitle = "slice " + axisName(normal) + " = " + formatValue(planeValue, false) +
                         " m   \u00b7   t = " + shortNumber(t) + " s (frame " +
-                        shortNumber(t * input.fps) + " at " + shortNumber(input.fps) + " fps)";
+                        shortNumber(t * input.fps + input.timeZero) + " at " + shortNumber(input.fps) +
+                        " fps)";
     settings.time = t;
     settings.style = o.style == "streamlines" ? viz::FlowStyle::Streamlines
                      : o.style == "none"      ? viz::FlowStyle::None

@@ -730,6 +730,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             fields::SampleTime when;
             when.time = t;
             when.fps = env.fps;
+            when.frameZero = env.frameZero;
             when.substep = env.substepIndex;
             when.threads = env.threads;
             const fields::SampleStatus ss = env.wind->sample(mX.data(), n, when, mWind.data());

@@ -93,6 +93,7 @@ struct Environment {
     Vec3 gravity = Vec3(0.0, -9.81, 0.0);
     const std::vector<Collider>* colliders = nullptr;
     double fps = 24.0;
+    double frameZero = 0.0; // the frame at t = 0 ($frame = t · fps + frameZero)
     int threads = 1;
     int substepIndex = 0;
 };

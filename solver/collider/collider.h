@@ -30,6 +30,7 @@ struct Collider {
     // Mesh from a moving sequence (`mesh = "body.#.obj"`): its triangles, tree and CCD (shared
     // state, prepared per substep; then `mesh` is null).
     std::shared_ptr<MovingMeshContact> moving;
+    int line = 0, col = 0; // where the scene file wrote it (0: not from a file)
 };
 
 // A contact query: signed distance to the surface (m, negative inside), the outward unit

@@ -13,18 +13,21 @@
 namespace gale::solver {
 
 MeshSequence::MeshSequence(std::vector<std::array<int, 3>> triangles,
-                           std::vector<std::vector<double>> frames, long firstFrame, double fps)
+                           std::vector<std::vector<double>> frames, long firstFrame, double fps,
+                           double frameZero)
     : mTriangles(std::move(triangles)), mFrames(std::move(frames)), mFirstFrame(firstFrame),
-      mFps(fps) {}
+      mFps(fps), mFrameZero(frameZero) {}
 
 std::shared_ptr<const MeshSequence> MeshSequence::load(const std::string& path, double fps,
-                                                       std::string& error) {
+                                                       std::string& error, double frameZero) {
     namespace fs = std::filesystem;
     const fs::path p(path);
-    // The policy of a scene key: the file's own folder (the scene already resolved the name).
+    // A scene key's file: resolved by the scene already, and not sandboxed (its frame files may
+    // be symbolic links into a cache elsewhere, as studio shot folders have them).
     geometry::FileAccess access;
     access.baseDir = p.parent_path().empty() ? "." : p.parent_path().string();
     access.rootDir = access.baseDir;
+    access.sandboxed = false;
     geometry::FileRef ref;
     if (!geometry::findFiles(access, p.filename().string(), ref, error)) return nullptr;
     std::vector<std::vector<double>> frames;
@@ -74,13 +77,14 @@ std::shared_ptr<const MeshSequence> MeshSequence::load(const std::string& path, 
         frames.push_back(std::move(m.positions));
     }
     auto seq = std::make_shared<MeshSequence>(std::move(triangles), std::move(frames),
-                                              ref.sequence ? ref.frames[0].frame : 0, fps);
+                                              ref.sequence ? ref.frames[0].frame : 0, fps,
+                                              frameZero);
     seq->mPath = path;
     return seq;
 }
 
 void MeshSequence::positionsAt(double t, std::vector<double>& out) const {
-    const double f = t * mFps - static_cast<double>(mFirstFrame);
+    const double f = t * mFps - (static_cast<double>(mFirstFrame) - mFrameZero);
     const long last = static_cast<long>(mFrames.size()) - 1;
     if (last <= 0 || !(f > 0.0)) {
         out = mFrames.front();
@@ -99,7 +103,7 @@ void MeshSequence::positionsAt(double t, std::vector<double>& out) const {
 }
 
 Vec3 MeshSequence::vertexAt(int v, double t) const {
-    const double f = t * mFps - static_cast<double>(mFirstFrame);
+    const double f = t * mFps - (static_cast<double>(mFirstFrame) - mFrameZero);
     const long last = static_cast<long>(mFrames.size()) - 1;
     if (last <= 0 || !(f > 0.0)) return vec3At(mFrames.front().data(), v);
     if (f >= static_cast<double>(last)) return vec3At(mFrames.back().data(), v);

@@ -1,6 +1,6 @@
 // Animated triangle meshes from per-frame files (`body.#.obj` -> body.0001.obj, ..., OBJ or PLY;
 // the `#` rule of vdb() and meshvel(), geometry/file_policy.h): one topology for every frame,
-// positions linear in time within a frame (frame F at t = F / fps), held before the first and
+// positions linear in time within a frame (frame F at t = (F − time_zero) / fps), held before the first and
 // after the last. A plain file name is a one-frame (static) sequence.
 #pragma once
 
@@ -18,16 +18,21 @@ public:
     // Loads every frame of `path` (resolved; a '#' run in the file name for a sequence). Null with
     // `error` naming the file: unreadable, a frame missing between the first and the last found
     // on disk, or a frame whose vertex count or faces differ from the first's.
+    // Frame F is at t = (F − frameZero) / fps (scene.time_zero).
     static std::shared_ptr<const MeshSequence> load(const std::string& path, double fps,
-                                                    std::string& error);
+                                                    std::string& error, double frameZero = 0.0);
     // From positions already in memory (frames[k] is frame firstFrame + k; tests, generators).
     MeshSequence(std::vector<std::array<int, 3>> triangles, std::vector<std::vector<double>> frames,
-                 long firstFrame, double fps);
+                 long firstFrame, double fps, double frameZero = 0.0);
 
     size_t vertexCount() const { return mFrames.empty() ? 0 : mFrames[0].size() / 3; }
     const std::vector<std::array<int, 3>>& triangles() const { return mTriangles; }
     size_t frameCount() const { return mFrames.size(); }
     long firstFrame() const { return mFirstFrame; }
+    long lastFrame() const { return mFirstFrame + static_cast<long>(mFrames.size()) - 1; }
+    double frameZero() const { return mFrameZero; }
+    // Seconds at frame F of the sequence.
+    double frameTime(double frame) const { return (frame - mFrameZero) / mFps; }
     double fps() const { return mFps; }
     bool moving() const { return mFrames.size() > 1; }
     const std::string& path() const { return mPath; }
@@ -44,6 +49,7 @@ private:
     std::vector<std::vector<double>> mFrames;
     long mFirstFrame = 0;
     double mFps = 24.0;
+    double mFrameZero = 0.0;
     std::string mPath;
 };
 

@@ -36,7 +36,8 @@ World::World(WorldSettings settings) : mSettings(std::move(settings)) {
 World::~World() = default;
 
 FrameStats World::advanceFrame(int frame) {
-    FrameStats fs = advance((frame - 1) / mSettings.fps, 1.0 / mSettings.fps, mSettings.substeps);
+    FrameStats fs = advance((frame - 1 - mSettings.timeZero) / mSettings.fps, 1.0 / mSettings.fps,
+                            mSettings.substeps);
     fs.frame = frame;
     return fs;
 }
@@ -186,6 +187,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
     env.gravity = mSettings.gravity;
     env.colliders = &mColliders;
     env.fps = mSettings.fps;
+    env.frameZero = mSettings.timeZero;
     env.threads = mSettings.threads;
     long& tick = run.tick;
     int& level = run.level;

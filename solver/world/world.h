@@ -16,6 +16,7 @@ namespace gale::solver {
 
 struct WorldSettings {
     double fps = 24.0;
+    double timeZero = 0.0; // the frame at t = 0 (scene.time_zero): frame F ends at (F − timeZero)/fps
     int substeps = 4;    // per frame, the minimum
     int maxHalvings = 6; // a substep may be split down to 1/2⁶ of its size
     Vec3 gravity = Vec3(0.0, -9.81, 0.0);

@@ -54,3 +54,15 @@ def test_simulate_equals_gale_sim(src, tmp_path, gale_bin):
     assert np.abs(frames[-1].positions["cape"] - frames[0].positions["cape"]).max() > 1e-3
     # Iteration ends after the last frame.
     assert next(iter(sim), None) is None
+
+
+def test_a_late_range_starts_from_the_simulated_state(src):
+    # Frames 6..9 on their own are the frames 6..9 of the run from the scene's first frame: the
+    # frames before the range are simulated first (never the rest mesh at frame 6).
+    s = gale.Scene(str(src / "examples" / "03_cape" / "scene.toml"))
+    full = {f.frame: f.positions["cape"] for f in s.simulate(frames=(1, 9))}
+    late = list(s.simulate(frames=(6, 9)))
+    assert [f.frame for f in late] == [6, 7, 8, 9]
+    for f in late:
+        np.testing.assert_array_equal(f.positions["cape"], full[f.frame])
+    assert np.abs(full[6] - full[1]).max() > 1e-3  # frame 6 is not the rest shape

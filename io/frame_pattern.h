@@ -1,0 +1,31 @@
+// Frame-numbered file names as DCCs write them: one frame token in a file name — a run of '#'
+// (`body.####.obj`, a lone '#' pads to 4 digits), printf's `%04d` / `%d` (Maya, Nuke) or
+// Houdini's `$F4` / `$F` — formatted for a frame and matched against names found on disk.
+#pragma once
+
+#include <string>
+
+namespace gale::io {
+
+// What the tokens look like, for messages: "a run of '#' (body.####.obj), %04d or $F4".
+extern const char* const kFrameTokens;
+
+struct FramePattern {
+    std::string prefix, suffix; // the name around the token
+    int width = 4;              // digits, zero-padded (1: unpadded); the sign comes first
+};
+
+// True when `name` holds a frame token anywhere (a sequence rather than a single file).
+bool hasFrameToken(const std::string& name);
+
+// The one frame token of `name`. False when it has none, or (with `error` set) more than one.
+bool parseFramePattern(const std::string& name, FramePattern& out, std::string* error = nullptr);
+
+// The name of `frame` (frame -3 at width 4 -> `-0003`).
+std::string formatFrame(const FramePattern& p, long frame);
+
+// The frame number of `name` when it is exactly what formatFrame writes for some frame
+// (prefix, the digits at the pattern's padding, suffix); false otherwise.
+bool matchFrame(const FramePattern& p, const std::string& name, long& frame);
+
+} // namespace gale::io

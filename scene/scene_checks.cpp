@@ -1,0 +1,132 @@
+// Run warnings of a scene (scene_checks.h): sequence coverage, units and reach of colliders.
+#include "scene/scene_checks.h"
+
+#include "solver/collider/moving_collider.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+namespace gale::scene {
+
+using solver::Vec3;
+
+namespace {
+
+struct Box {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+    void add(const Vec3& p) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    void add(const Box& b) {
+        lo = lo.cwiseMin(b.lo);
+        hi = hi.cwiseMax(b.hi);
+    }
+    bool empty() const { return !(lo.x() <= hi.x()); }
+    double extent() const { return empty() ? 0.0 : (hi - lo).norm(); }
+    // The gap between two boxes (0 when they overlap).
+    double gap(const Box& b) const { return (lo - b.hi).cwiseMax(b.lo - hi).cwiseMax(0.0).norm(); }
+};
+
+Box boxOf(const std::vector<double>& xyz) {
+    Box b;
+    for (size_t i = 0; i + 2 < xyz.size(); i += 3) b.add(Vec3(xyz[i], xyz[i + 1], xyz[i + 2]));
+    return b;
+}
+
+std::string metres(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+}
+
+// Where a collider's surface can be over the run: every frame of a sequence, or an analytic
+// shape at the run's start (an empty box for planes and static meshes: not looked at).
+Box colliderBox(const solver::Collider& c, double t0) {
+    Box b;
+    if (c.moving) {
+        const solver::MeshSequence& seq = c.moving->mesh();
+        std::vector<double> x;
+        for (long f = seq.firstFrame(); f <= seq.lastFrame(); ++f) {
+            seq.positionsAt(seq.frameTime(static_cast<double>(f)), x);
+            b.add(boxOf(x));
+        }
+        return b;
+    }
+    if (c.shape == solver::ColliderShape::Sphere || c.shape == solver::ColliderShape::Capsule) {
+        const solver::ColliderPose p = solver::colliderPose(c, t0);
+        const Vec3 r = Vec3::Constant(c.radius);
+        b.add(p.a - r);
+        b.add(p.a + r);
+        if (c.shape == solver::ColliderShape::Capsule) {
+            b.add(p.b - r);
+            b.add(p.b + r);
+        }
+    }
+    return b;
+}
+
+} // namespace
+
+std::vector<SceneError> runWarnings(const SimScene& scene,
+                                    const std::vector<std::unique_ptr<solver::Body>>& bodies,
+                                    int first, int last) {
+    std::vector<SceneError> out;
+    const fields::SceneSettings& s = scene.wind.settings;
+    auto warn = [&](const solver::Collider& c, std::string message) {
+        SceneError e = sceneErrorAt(scene.wind.path, c.line, c.col, std::move(message));
+        e.warning = true;
+        out.push_back(std::move(e));
+    };
+    Box cloth;
+    double clothExtent = 0.0;
+    std::vector<Box> bodyBoxes;
+    for (const auto& b : bodies) {
+        std::vector<double> x(b->positions().data(), b->positions().data() + b->positions().size());
+        bodyBoxes.push_back(boxOf(x));
+        cloth.add(bodyBoxes.back());
+        clothExtent = std::max(clothExtent, bodyBoxes.back().extent());
+    }
+    for (const solver::Collider& c : scene.colliders) {
+        const std::string what = "[[collider]] '" + c.name + "'";
+        // A sequence that ends before the run (or starts after it): the body stands still there.
+        if (c.moving && c.moving->mesh().moving()) {
+            // The sequence was loaded with the scene's fps and time_zero: its frame numbers are
+            // the run's.
+            const solver::MeshSequence& seq = c.moving->mesh();
+            if (last > seq.lastFrame() || first < seq.firstFrame())
+                warn(c, what + ": its mesh sequence '" + seq.path() + "' has frames " +
+                            std::to_string(seq.firstFrame()) + "-" +
+                            std::to_string(seq.lastFrame()) + " but the run goes from frame " +
+                            std::to_string(first) + " to " + std::to_string(last) +
+                            ": outside its frames the body holds its first or "
+                            "last pose (write the frames, or shorten the run)");
+        }
+        const Box box = colliderBox(c, s.frameTime(first));
+        if (box.empty() || cloth.empty() || !(clothExtent > 0.0)) continue;
+        const double extent = box.extent();
+        if (extent > 25.0 * clothExtent)
+            warn(c, what + " is " + metres(extent) + " m across, " + metres(extent / clothExtent) +
+                        "x the largest cloth or hair (" + metres(clothExtent) +
+                        " m): modelled in centimetres? gale's units are metres (export at a scale "
+                        "of 0.01)");
+        else if (25.0 * extent < clothExtent)
+            warn(c, what + " is " + metres(extent) + " m across, 1/" +
+                        metres(clothExtent / extent) + " of the largest cloth or hair (" +
+                        metres(clothExtent) +
+                        " m): is the cloth in centimetres? gale's units are metres");
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Box& b : bodyBoxes) nearest = std::min(nearest, box.gap(b));
+        const double reach = std::max(1.0, 2.0 * clothExtent);
+        if (nearest > reach)
+            warn(c, what + " never comes within " + metres(nearest) +
+                        " m of any cloth or hair over the run: check its position (or remove it)");
+    }
+    return out;
+}
+
+} // namespace gale::scene

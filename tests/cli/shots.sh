@@ -1,0 +1,151 @@
+# Shot conventions (../shared/spec/cli.md, "Shots"): studio frame numbers with time_zero, mesh
+# sequences named as DCCs write them (#, %04d, $F4), frame files that are symbolic links into a
+# cache elsewhere, and `gale check` loading the whole scene as a run would.
+# The reference for time_zero is the same shot renumbered to start at frame 0: $t is the same
+# at every frame, so every output frame must be byte for byte the same.
+source "$(dirname "$0")/lib.bash" "$@"
+
+# A box body sliding along +x at 0.5 m/s under a sheet pinned at one edge, one file per frame.
+write_body() { # write_body FOLDER FIRST LAST NAME_PRINTF_FORMAT
+    mkdir -p "$1"
+    for ((f = $2; f <= $3; f++)); do
+        awk -v x=$(awk -v k=$((f - $2)) 'BEGIN { printf "%.6f", k * 0.5 / 24 }') 'BEGIN {
+            split("-0.2 0.2", X); split("0.2 0.5", Y); split("-0.2 0.2", Z)
+            for (i = 1; i <= 2; i++) for (j = 1; j <= 2; j++) for (k = 1; k <= 2; k++)
+                printf "v %.6f %.6f %.6f\n", X[i] + x, Y[j], Z[k]
+            print "f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4" }' \
+            > "$1/$(printf "$4" "$f")"
+    done
+}
+write_scene() { # write_scene FILE FIRST LAST TIME_ZERO MESH
+    cat > "$1" <<EOF
+[scene]
+fps = 24
+frames = [$2, $3]
+time_zero = $4
+substeps = 2
+
+[windicator]
+direction = [0, 0, 1]
+speed = { keys = [[0, 0], [0.25, 6]] }
+
+[[cloth]]
+name = "sheet"
+grid = { size = [0.6, 0.6], res = [10, 10], origin = [-0.3, 0.6, -0.3], axes = "xz" }
+pins = { box = [-0.31, 0.59, -0.31, 0.31, 0.61, -0.29] }
+
+[[collider]]
+name = "box"
+type = "mesh"
+mesh = "$5"
+EOF
+}
+
+mkdir shot renumbered
+write_body shot/cache 1001 1013 'body.%04d.obj'
+write_body renumbered/cache 0 12 'body.%04d.obj'
+write_scene shot/scene.toml 1001 1012 1001 'cache/body.####.obj'
+write_scene renumbered/scene.toml 0 11 0 'cache/body.####.obj'
+
+run "$GALE" check shot/scene.toml
+expect_rc 0 "the shot checks clean"
+run "$GALE" sim shot/scene.toml -o shot/out
+expect_rc 0 "the shot at frames 1001-1012"
+run "$GALE" sim renumbered/scene.toml -o renumbered/out
+expect_rc 0 "the same shot renumbered from 0"
+for ((f = 0; f <= 11; f++)); do
+    a=shot/out/sheet.$(printf %04d $((f + 1001))).obj
+    b=renumbered/out/sheet.$(printf %04d $f).obj
+    [ -s "$a" ] || fail "$a written"
+    cmp -s "$a" "$b" || fail "frame $((f + 1001)) of the shot is frame $f renumbered"
+done
+# The wind rose with the shot's own time: the sheet moved by its last frame.
+cmp -s shot/out/sheet.1001.obj shot/out/sheet.1012.obj && fail "the shot's wind moves the sheet"
+expect_match "$(head -c 400 shot/out/run.json)" '"frames": \[1001, 1012\]' "run.json has the studio frames"
+t1012=$(grep -o '"frame": 1012, "time": [^,]*' shot/out/run.json | sed 's/.*: //')
+awk -v t="$t1012" 'BEGIN { exit !(t > 0.4583 && t < 0.4584) }' || fail "frame 1012 ends at 11/24 s, got $t1012"
+
+# A range that starts mid-shot starts from the simulated state there: the frames before it are
+# simulated first, so each frame is the full run's, byte for byte (never the rest mesh
+# teleported to the body's pose at the range's first frame).
+run "$GALE" sim shot/scene.toml -o shot/late --frames 1008:1012
+expect_rc 0 "a range that starts mid-shot"
+expect_match "$ERR" "frames 1001-1008 are simulated first and not written" "the run-up is said ($ERR)"
+[ -e shot/late/sheet.1007.obj ] && fail "frames before the range are not written"
+for ((f = 1008; f <= 1012; f++)); do
+    cmp -s shot/late/sheet.$f.obj shot/out/sheet.$f.obj || fail "frame $f of --frames 1008:1012 is the full run's"
+done
+
+# $frame is the studio frame, $t the shot time.
+cat > shot/frame.se <<'EOF'
+[$frame, $t, 0]
+EOF
+cat >> shot/scene.toml <<'EOF'
+
+[[field]]
+name = "probe"
+expr = "frame.se"
+EOF
+run "$GALE" eval shot/scene.toml --frame 1013
+expect_rc 0 "eval at a studio frame"
+expect_match "$OUT" '^1013,0.5,0$|^1013 0.5 0$' "\$frame = 1013 and \$t = 0.5 s at frame 1013 ($OUT)"
+
+# The DCC spellings of a sequence name the same files.
+for name in 'cache/body.%04d.obj' 'cache/body.$F4.obj'; do
+    write_scene renumbered/dcc.toml 0 11 0 "$name"
+    run "$GALE" sim renumbered/dcc.toml -o renumbered/dcc
+    expect_rc 0 "a sequence named $name"
+    cmp -s renumbered/dcc/sheet.0011.obj renumbered/out/sheet.0011.obj || fail "$name gives the same run as ####"
+done
+# A name that matches no file says which tokens gale reads.
+write_scene renumbered/bad.toml 0 11 0 'cache/body.%03d.obj'
+run "$GALE" check renumbered/bad.toml
+expect_rc 1 "a sequence with no files"
+expect_match "$ERR" "bad.toml:[0-9]+:[0-9]+: .*no files of the sequence.*%04d or \\\$F4" "the error names the tokens ($ERR)"
+
+# Frame files that are symbolic links to a cache elsewhere are the scene's own choice.
+mkdir -p linked elsewhere
+write_body elsewhere/cache 0 12 'body.%04d.obj'
+mkdir linked/cache
+for f in elsewhere/cache/*.obj; do ln -s "$TMP/$f" "linked/cache/$(basename "$f")"; done
+write_scene linked/scene.toml 0 11 0 'cache/body.####.obj'
+run "$GALE" check linked/scene.toml
+expect_rc 0 "symlinked frame files check clean"
+run "$GALE" sim linked/scene.toml -o linked/out
+expect_rc 0 "symlinked frame files simulate"
+cmp -s linked/out/sheet.0011.obj renumbered/out/sheet.0011.obj || fail "the linked cache gives the same run"
+
+# Likely mistakes are warnings at the collider's line: a run longer than the body's sequence,
+# a body in centimetres, a collider far from every cloth. The shot as written has none.
+expect_no_match "$(cd shot && "$GALE" check scene.toml 2>&1)" "warning" "the shot has no warnings"
+run "$GALE" check renumbered/scene.toml --set 'scene.frames=[0, 20]'
+expect_rc 0 "a run past the sequence still checks"
+expect_match "$ERR" "scene.toml:16:1: warning: \[\[collider\]\] 'box': its mesh sequence .* has frames 0-12 but the run goes from frame 0 to 20" "the run outlives the sequence ($ERR)"
+mkdir -p cm/cache
+for f in renumbered/cache/*.obj; do awk '/^v / { printf "v %.4f %.4f %.4f\n", $2 * 100, $3 * 100, $4 * 100; next } { print }' "$f" > cm/cache/$(basename "$f"); done
+write_scene cm/scene.toml 0 11 0 'cache/body.####.obj'
+run "$GALE" check cm/scene.toml
+expect_match "$ERR" "scene.toml:16:1: warning: .*'box' is [0-9.]+ m across, [0-9.]+x the largest cloth .*centimetres" "a body in centimetres ($ERR)"
+mkdir -p far/cache
+for f in renumbered/cache/*.obj; do awk '/^v / { printf "v %.4f %.4f %.4f\n", $2 + 30, $3, $4; next } { print }' "$f" > far/cache/$(basename "$f"); done
+write_scene far/scene.toml 0 11 0 'cache/body.####.obj'
+run "$GALE" sim far/scene.toml -o far/out
+expect_rc 0 "a far collider does not stop a run"
+expect_match "$ERR" "scene.toml:16:1: warning: .*'box' never comes within [0-9.]+ m of any cloth" "a collider far from the cloth ($ERR)"
+
+# gale check builds the bodies too: what `gale sim` rejects, check rejects, at the same place.
+cat > bad_body.toml <<'EOF'
+[scene]
+frames = [1, 2]
+
+[[cloth]]
+name = "sheet"
+mesh = "missing.obj"
+EOF
+run "$GALE" check bad_body.toml
+check_rc=$RC
+check_err=$ERR
+run "$GALE" sim bad_body.toml -o bad_out
+expect_eq "$check_rc" "$RC" "check and sim exit alike on a missing cloth mesh"
+expect_match "$check_err" "bad_body.toml:[0-9]+:[0-9]+: .*missing.obj" "check names the scene place and the mesh ($check_err)"
+finish
