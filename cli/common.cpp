@@ -27,6 +27,18 @@ void printError(const std::string& message) {
     std::cerr << "gale: " << message << '\n';
 }
 
+int printSceneErrors(const std::vector<scene::SceneError>& errors) {
+    bool io = false;
+    for (const scene::SceneError& e : errors) {
+        std::string text = e.render();
+        if (text.empty() || text.back() != '\n') text += '\n';
+        std::cerr << text;
+        io = io || e.io;
+    }
+    std::cerr << std::flush;
+    return io ? kExitIo : kExitInput;
+}
+
 bool useColor() {
     const char* noColor = std::getenv("NO_COLOR");
     if (noColor && *noColor) return false;

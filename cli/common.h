@@ -7,6 +7,7 @@
 #include "io/pointset.h"
 #include "lang/source.h"
 #include "runtime/program.h"
+#include "scene/error.h"
 
 #include <deque>
 #include <memory>
@@ -28,6 +29,10 @@ namespace gale::cli {
 
 // "gale: <message>" on stderr.
 void printError(const std::string& message);
+
+// Prints every scene error (file:line:col, source line, caret, notes) to stderr; returns the exit
+// code they call for: 3 when a file could not be read, else 1.
+int printSceneErrors(const std::vector<scene::SceneError>& errors);
 // Colour diagnostics when stderr is a terminal and NO_COLOR is unset or empty.
 bool useColor();
 

@@ -22,24 +22,13 @@ namespace gale::cli {
 
 namespace {
 
-// Prints scene errors; the exit code they call for (3 when a file could not be read).
-int reportSceneErrors(const std::vector<scene::SceneError>& errors) {
-    bool io = false;
-    for (const scene::SceneError& e : errors) {
-        std::cerr << e.render() << '\n';
-        io = io || e.io;
-    }
-    std::cerr << std::flush;
-    return io ? kExitIo : kExitInput;
-}
-
 // Loads a scene (with --set applied by dotted path), compiles every field and builds its bodies
 // as a run would; returns an exit code after printing every problem.
 int checkScene(const std::string& path, const std::vector<std::string>& sets,
                const std::vector<std::string>& allowPaths) {
     gale::scene::SimScene sim;
     std::vector<scene::SceneError> errors;
-    if (!gale::scene::loadSimScene(path, sim, errors, sets)) return reportSceneErrors(errors);
+    if (!gale::scene::loadSimScene(path, sim, errors, sets)) return printSceneErrors(errors);
     std::string report;
     fields::FieldPtr field =
         fields::buildSceneField(sim.wind, runtime::Precision::Float, report, useColor(), allowPaths);
@@ -48,7 +37,7 @@ int checkScene(const std::string& path, const std::vector<std::string>& sets,
     std::vector<std::string> warnings;
     const bool built = gale::scene::buildBodies(sim, bodies, errors, warnings, allowPaths);
     for (const std::string& w : warnings) std::cerr << "gale: warning: " << w << '\n';
-    if (!built) return reportSceneErrors(errors);
+    if (!built) return printSceneErrors(errors);
     for (const scene::SceneError& w : gale::scene::runWarnings(
              sim, bodies, sim.wind.settings.frameStart, sim.wind.settings.frameEnd))
         std::cerr << w.render() << '\n';

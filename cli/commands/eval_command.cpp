@@ -278,17 +278,6 @@ int streamPoints(const EvalOptions& o, PointStream& s, const ChunkEval& eval,
     return kExitOk;
 }
 
-// Prints every scene error; returns 3 when a file could not be read, else 1.
-int reportSceneErrors(const std::vector<scene::SceneError>& errors) {
-    bool io = false;
-    for (const scene::SceneError& e : errors) {
-        std::cerr << e.render() << '\n';
-        io = io || e.io;
-    }
-    std::cerr << std::flush;
-    return io ? kExitIo : kExitInput;
-}
-
 // `gale eval SCENE.toml`: the scene's summed wind at the origin or at every point. --set
 // overrides scene keys by dotted path; --fps defaults to the scene's.
 int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints, io::PointFormat format) {
@@ -305,7 +294,7 @@ int runEvalScene(const EvalOptions& o, bool fpsGiven, bool havePoints, io::Point
     gale::scene::SceneLoadOptions options;
     options.sets = o.source.sets;
     if (!gale::scene::loadScene(o.source.file, scene, errors, options))
-        return reportSceneErrors(errors);
+        return printSceneErrors(errors);
     const bool asFloat = o.precision != "double";
     std::string report;
     fields::FieldPtr field = fields::buildSceneField(

@@ -121,16 +121,8 @@ int loadSceneInput(const SourceOptions& source, FieldInput& out) {
     std::vector<scene::SceneError> errors;
     gale::scene::SceneLoadOptions options;
     options.sets = source.sets;
-    if (!gale::scene::loadScene(source.file, *scene, errors, options)) {
-        bool io = false;
-        for (const scene::SceneError& e : errors) {
-            std::string text = e.render();
-            if (text.empty() || text.back() != '\n') text += '\n';
-            std::cerr << text;
-            io = io || e.io;
-        }
-        return io ? kExitIo : kExitInput;
-    }
+    if (!gale::scene::loadScene(source.file, *scene, errors, options))
+        return printSceneErrors(errors);
     std::string report;
     fields::FieldPtr field =
         fields::buildSceneField(*scene, runtime::Precision::Float, report, useColor(),

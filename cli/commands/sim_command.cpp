@@ -113,8 +113,11 @@ int runSim(const SimOptions& o) {
         Progress runUp(sim.runUpFrames());
         int step = 0;
         solver::FrameStats failed;
-        if (!sim.runUp([&](const solver::FrameStats&) { runUp.update(++step, from + step); },
-                       failed)) {
+        auto shown = [&](const solver::FrameStats&) {
+            ++step;
+            runUp.update(step, from + step);
+        };
+        if (!sim.runUp(shown, failed)) {
             runUp.finish();
             printError("frame " + std::to_string(failed.frame) +
                        " (before the range): the run failed numerically (non-finite state that "

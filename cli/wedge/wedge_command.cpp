@@ -129,13 +129,9 @@ int runWedge(const WedgeOptions& o) {
         scene::SimScene scene;
         std::vector<scene::SceneError> errors;
         if (!gale::scene::loadSimScene(o.scene, scene, errors, sets)) {
-            bool io = false;
-            for (const scene::SceneError& e : errors) {
-                std::cerr << e.render() << '\n';
-                io = io || e.io;
-            }
+            const int rc = printSceneErrors(errors);
             printError("variant " + describe(v) + " does not load; no variant was written");
-            return io ? kExitIo : kExitInput;
+            return rc;
         }
         v.frameStart = scene.wind.settings.frameStart;
         v.frameEnd = scene.wind.settings.frameEnd;
