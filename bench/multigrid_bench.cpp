@@ -63,11 +63,9 @@ Outcome runSolve(const ClothSystem& s, const Variant& v, double tol, int threads
         solver.setPreconditioner(Preconditioner::Multigrid);
         BlockMultigrid::Settings& st = solver.multigrid().settings();
         st.smoothed = v.smoothed;
+        st.smoothedMinRows = 0; // the variant's hierarchy at every size
         st.rotations = v.rotations;
         st.sweeps = v.sweeps;
-        if (const char* e = std::getenv("GALE_MG_DAMPING")) st.prolongatorDamping = std::atof(e);
-        if (const char* e = std::getenv("GALE_MG_POWER")) st.powerIterations = std::atoi(e);
-        if (const char* e = std::getenv("GALE_MG_COARSEST")) st.coarsest = std::atoi(e);
         solver.multigrid().setPositions(s.x.data(), s.A.size());
         o.setup = o.solve = 1e30;
         for (int r = 0; r < repeats; ++r) {

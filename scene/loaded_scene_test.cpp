@@ -138,3 +138,34 @@ TEST_CASE("multigrid: the scene key picks the preconditioner; a bad value is an 
     CHECK(ec.find(path + ":4:18: error: unknown preconditioner 'amg'") != std::string::npos);
     std::remove(path.c_str());
 }
+
+TEST_CASE("multigrid: the multigrid key picks plain or smoothed aggregation; a bad value is an error",
+          "[multigrid][scene]") {
+    char tmpl[] = "/tmp/gale_multigrid_kind_XXXXXX";
+    const int fd = mkstemp(tmpl);
+    REQUIRE(fd >= 0);
+    close(fd);
+    const std::string path = tmpl;
+    auto load = [&](const std::string& value, SimScene& scene, std::string& errors) {
+        std::ofstream(path) << "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n"
+                            << (value.empty() ? "" : "multigrid = " + value + "\n");
+        std::vector<gale::scene::SceneError> errs;
+        const bool ok = loadSimScene(path, scene, errs, {});
+        for (const auto& e : errs) errors += e.render() + "\n";
+        return ok;
+    };
+    SimScene a, b, c, d, e;
+    std::string ea, eb, ec, ed, ee;
+    REQUIRE(load("", a, ea));
+    CHECK(a.cloths[0].step.multigrid == MultigridKind::Automatic); // the default
+    REQUIRE(load("\"plain\"", b, eb));
+    CHECK(b.cloths[0].step.multigrid == MultigridKind::Plain);
+    REQUIRE(load("\"smoothed\"", c, ec));
+    CHECK(c.cloths[0].step.multigrid == MultigridKind::Smoothed);
+    REQUIRE(load("\"auto\"", d, ed));
+    CHECK(d.cloths[0].step.multigrid == MultigridKind::Automatic);
+    CHECK_FALSE(load("\"sa\"", e, ee));
+    INFO(ee);
+    CHECK(ee.find(path + ":4:13: error: unknown multigrid 'sa'") != std::string::npos);
+    std::remove(path.c_str());
+}

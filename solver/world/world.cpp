@@ -15,8 +15,6 @@
 namespace gale::solver {
 
 namespace {
-// Newton iterations of the retry of a substep in trouble (World::advanceBody).
-constexpr int kRetryNewtonIterations = 16;
 // A self-collision pass that leaves an edge longer than kPassStretch × its rest length and
 // kPassStretchGrowth × what the solve left has its interval redone at half the step.
 constexpr double kPassStretch = 1.1;
@@ -205,6 +203,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         // Over-stretch or a velocity jump from the linearised step: first the same substep again
         // with Newton's line search (which cuts a step that over-stretches), then halving.
         const int newton = body.options().newtonIterations;
+        const int kRetryNewtonIterations = mSettings.retryNewtonIterations;
         if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
             newton < kRetryNewtonIterations && !mSettings.noNewtonRetry) {
             std::snprintf(buf, sizeof buf,

@@ -23,6 +23,11 @@ struct WorldSettings {
     double airDensity = 1.225;  // kg/m³
     int threads = 1;            // 0: all hardware threads; results do not depend on it
     bool noNewtonRetry = false; // tests and benchmarks of the raw halving: no Newton retry
+    // Newton iterations of the retry of a substep in trouble (World::stepBody). Fewer make the
+    // onset frame cheaper but not reliably better (bench/README.md, issue 26: at 64² 1 gives
+    // worst/median 2.0× but a larger max stretch there and on hard_test's flags; 2 and 4 do not
+    // reach 3×), so it stays 16.
+    int retryNewtonIterations = 16;
 };
 
 // Per body, per frame.
