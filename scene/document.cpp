@@ -128,40 +128,44 @@ std::string SceneDocument::write(const std::string& header) const {
     return text.str();
 }
 
-std::vector<std::string> SceneDocument::namedFiles() const {
-    std::vector<std::string> out;
-    const fs::path base = fs::path(m->path).parent_path();
+namespace {
+
+// Calls fn(path) for every string value of the tree, as a path relative to `base` (strings of
+// 1000 bytes or more are not file names).
+template <class Fn>
+void eachPathString(const toml::node& root, const fs::path& base, Fn&& fn) {
     auto walk = [&](const toml::node& n, auto&& self) -> void {
         if (const auto* s = n.as_string()) {
-            const fs::path p = base / s->get();
-            std::error_code ec;
-            if (s->get().size() < 1000 && fs::is_regular_file(p, ec)) out.push_back(p.string());
+            if (s->get().size() < 1000) fn(s->get(), base / s->get());
         } else if (const auto* t = n.as_table()) {
             for (const auto& kv : *t) self(kv.second, self);
         } else if (const auto* a = n.as_array()) {
             for (const auto& e : *a) self(e, self);
         }
     };
-    walk(m->root, walk);
+    walk(root, walk);
+}
+
+} // namespace
+
+std::vector<std::string> SceneDocument::namedFiles() const {
+    std::vector<std::string> out;
+    eachPathString(m->root, fs::path(m->path).parent_path(),
+                   [&](const std::string&, const fs::path& p) {
+                       std::error_code ec;
+                       if (fs::is_regular_file(p, ec)) out.push_back(p.string());
+                   });
     return out;
 }
 
 std::vector<std::string> SceneDocument::otherPaths() const {
     std::vector<std::string> out;
-    const fs::path base = fs::path(m->path).parent_path();
-    auto walk = [&](const toml::node& n, auto&& self) -> void {
-        if (const auto* s = n.as_string()) {
-            const fs::path p = base / s->get();
-            std::error_code ec;
-            if (s->get().size() < 1000 && !s->get().empty() && !fs::is_regular_file(p, ec))
-                out.push_back(p.lexically_normal().string());
-        } else if (const auto* t = n.as_table()) {
-            for (const auto& kv : *t) self(kv.second, self);
-        } else if (const auto* a = n.as_array()) {
-            for (const auto& e : *a) self(e, self);
-        }
-    };
-    walk(m->root, walk);
+    eachPathString(m->root, fs::path(m->path).parent_path(),
+                   [&](const std::string& s, const fs::path& p) {
+                       std::error_code ec;
+                       if (!s.empty() && !fs::is_regular_file(p, ec))
+                           out.push_back(p.lexically_normal().string());
+                   });
     return out;
 }
 
