@@ -337,11 +337,11 @@ function wire() {
         drawSimFrame();
       }
       const r = await api('/api/simulate', { action: running ? 'stop' : 'start' });
+      // The button follows `on` (Simulate pressed and not stopped: a run that ended by itself
+      // leaves it on, and edits re-simulate), so a Stop after the run's end turns it off.
+      $('simulate').textContent = r.running || r.on ? 'Stop' : 'Simulate';
       // (A short run may have ended, and its event been shown, before this reply.)
-      if (r.run !== endedRun) {
-        $('simulate').textContent = r.running || r.on ? 'Stop' : 'Simulate';
-        $('simText').textContent = r.running ? 'simulating…' : '';
-      }
+      if (r.run !== endedRun) $('simText').textContent = r.running ? 'simulating…' : '';
     } catch (e) {
       $('simText').textContent = String(e.message || e);
     }

@@ -156,6 +156,25 @@ try {
     c.check(changed > 0.01, `the previous run's flag shows inside the flag's box: ${(100 * changed).toFixed(1)} % of its pixels change`);
   }
   await page.screenshot({ path: SHOT });
+
+  // ---- a run that ends by itself: Stop, then Simulate starts a new run ----
+  // (On a fast machine the first run above can end before its Stop; the button must still
+  // turn Stop into Simulate, and the next press start a run, not stop one that has ended.)
+  const toml = path.join(DIR, 'scene.toml');
+  fs.writeFileSync(toml, fs.readFileSync(toml, 'utf8').replace(/^frames = \[1, 240\]/m, 'frames = [1, 6]'));
+  await c.until(() => page.evaluate(async () => {
+    const token = new URLSearchParams(location.search).get('token');
+    const r = await fetch(`/api/state?token=${token}`);
+    return r.ok && (await r.json()).frames[1] === 6;
+  }), 10000, 'the page sees the scene\'s new frame range');
+  const before6 = await page.evaluate(() => window.galeLive.simRun);
+  await page.click('#simulate');
+  await c.until(() => page.evaluate((r) => window.galeLive.simRun > r && /done/.test(document.getElementById('simText').textContent), before6), 20000, 'a 6-frame run ends by itself');
+  await page.click('#simulate'); // Stop (edits no longer re-simulate)
+  await c.until(() => page.evaluate(() => document.getElementById('simulate').textContent === 'Simulate'), 5000, 'Stop after the run\'s end turns the button back to Simulate');
+  const ended = await page.evaluate(() => window.galeLive.simRun);
+  await page.click('#simulate');
+  await c.until(() => page.evaluate((r) => window.galeLive.simRun === r + 1 && window.galeLive.framesOfRun >= 6, ended), 20000, 'Simulate then starts a new run, which writes its 6 frames');
   if (c.failures) console.log(logs.join('\n'));
 } finally {
   await close();
