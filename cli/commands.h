@@ -142,6 +142,7 @@ struct SimOptions {
     bool json = false;             // print run.json's content to stdout at the end
     std::vector<std::string> allowPaths; // --allow-path DIR (files named by expressions)
     std::string cache;             // --cache mdd: OUTDIR/<object>.mdd point caches too
+    bool strict = false;           // exit 4 at the first frame that ends in trouble
 };
 int runSim(const SimOptions& options);
 Command addSimCommand(CLI::App& app);

@@ -159,6 +159,18 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";
         for (size_t e = 0; e < b.events.size(); ++e)
             o << (e ? ", " : "") << jsonString(b.events[e]);
+        o << "], \"trouble\": [";
+        for (size_t e = 0; e < b.trouble.size(); ++e) {
+            const solver::FrameTrouble& t = b.trouble[e];
+            o << (e ? ", " : "") << "{\"kind\": \"" << t.kindName() << "\", \"vertex\": " << t.vertex;
+            if (t.other >= 0) o << ", \"other_vertex\": " << t.other;
+            o << ", \"position\": [" << num(t.position.x()) << ", " << num(t.position.y()) << ", "
+              << num(t.position.z()) << "], \""
+              << (t.kind == solver::FrameTrouble::Kind::OverStretch ? "stretch" : "depth")
+              << "\": " << num(t.amount) << ", \"limit\": " << num(t.limit)
+              << ", \"count\": " << t.count << ", \"forced_by\": " << jsonString(t.forcedBy)
+              << ", \"scene\": " << (t.scene ? "true" : "false") << "}";
+        }
         o << "]}";
     }
     o << "]";

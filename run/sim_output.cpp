@@ -254,9 +254,9 @@ RunError SimOutput::saveFrame(const solver::FrameStats& stats) {
     return writeRun("running", nullptr);
 }
 
-void SimOutput::saveFailedFrame(const solver::FrameStats& stats) {
+void SimOutput::saveFailedFrame(const solver::FrameStats& stats, const std::string& status) {
     mFrames.push_back(frameJson(stats));
-    writeRun("failed", nullptr);
+    writeRun(status, nullptr);
 }
 
 RunError SimOutput::finish(std::string& runText) {

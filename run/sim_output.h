@@ -36,8 +36,9 @@ public:
     // Writes the frame's object files and caches, its state and stats, and (at most once a
     // second, and after the first frame) run.json with status "running".
     RunError saveFrame(const solver::FrameStats& stats);
-    // Adds a failed frame's stats and writes run.json with status "failed".
-    void saveFailedFrame(const solver::FrameStats& stats);
+    // Adds a failed frame's stats (its files are not written) and writes run.json with status
+    // `status`: "failed" (numerically), or "trouble" (refused by gale sim --strict).
+    void saveFailedFrame(const solver::FrameStats& stats, const std::string& status = "failed");
     // Writes run.json with status "ok"; its text in `runText`.
     RunError finish(std::string& runText);
 

@@ -133,16 +133,31 @@ int runSim(const SimOptions& o) {
     for (int f = out.nextFrame(); f <= last; ++f) {
         progress.update(done, f);
         const solver::FrameStats stats = sim.advance(f);
+        bool trouble = false;
         for (const solver::BodyFrameStats& b : stats.bodies) {
-            const size_t shown = std::min<size_t>(b.events.size(), 3);
+            // (The frame-end trouble is in `events` too, shown below as warnings.)
+            const size_t events = b.events.size() - b.trouble.size();
+            const size_t shown = std::min<size_t>(events, 3);
             for (size_t e = 0; e < shown; ++e) {
                 std::string line =
                     "gale: frame " + std::to_string(f) + ": " + b.name + ": " + b.events[e];
-                if (e + 1 == shown && b.events.size() > shown)
-                    line +=
-                        " (and " + std::to_string(b.events.size() - shown) + " more in run.json)";
+                if (e + 1 == shown && events > shown)
+                    line += " (and " + std::to_string(events - shown) + " more in run.json)";
                 progress.message(line);
             }
+            for (const solver::FrameTrouble& t : b.trouble)
+                progress.message("gale: warning: frame " + std::to_string(f) + ": " + b.name +
+                                 ": " + t.text());
+            trouble = trouble || !b.trouble.empty();
+        }
+        if (trouble && o.strict && !stats.failed) {
+            out.saveFailedFrame(stats, "trouble");
+            progress.finish();
+            printError("frame " + std::to_string(f) +
+                       " ends in trouble (over-stretched or inside a collider, above) and "
+                       "--strict refuses it: frames up to " + std::to_string(f - 1) +
+                       " are written, details in " + out.runJsonPath());
+            return kExitNumeric;
         }
         if (stats.failed) {
             out.saveFailedFrame(stats);
@@ -202,6 +217,11 @@ Command addSimCommand(CLI::App& app) {
                     "Modo and Cinema 4D play as one animated object; docs/dcc.md)")
         ->type_name("FORMAT");
     sub->add_flag("--json", o->json, "Print run.json's content to stdout at the end");
+    sub->add_flag("--strict", o->strict,
+                  "Exit 4 at the first frame that ends over-stretched (beyond [solver] "
+                  "over_stretch) or with cloth inside a collider, before writing it (for farms "
+                  "that must not render bad caches); without it such frames are written with a "
+                  "warning");
     return {sub, [o] { return runSim(*o); }};
 }
 

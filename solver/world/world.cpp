@@ -293,6 +293,9 @@ void World::finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const 
     stats.kinetic = body.kineticEnergy();
     stats.potential = body.potentialEnergy(mSettings.gravity);
     stats.elastic = body.elasticEnergy(t1);
+    if (stats.failed) return;
+    findFrameTrouble(body, mColliders, t1, body.limits().overStretch, stats.trouble);
+    for (const FrameTrouble& tr : stats.trouble) stats.events.push_back("trouble: " + tr.text());
 }
 
 // ---- state bytes: "GALESTATE" v1, then per body: name, vertex count, x, v, Δv guess, h guess.

@@ -6,6 +6,7 @@
 #include "fields/field.h"
 #include "solver/bodies/body.h"
 #include "solver/collider/collider.h"
+#include "solver/world/frame_trouble.h"
 #include "solver/world/self_collision.h"
 
 #include <memory>
@@ -64,6 +65,8 @@ struct BodyFrameStats {
     // when it takes part in cloth–cloth collision (−1: not counted).
     int selfIntersections = -1;
     std::vector<std::string> events; // substep halvings and recoveries, with reasons
+    // What the frame ends with beyond over_stretch or inside a collider (also in `events`).
+    std::vector<FrameTrouble> trouble;
     bool failed = false;             // non-finite state that halving could not fix (state restored)
 };
 
