@@ -37,8 +37,9 @@ const char* FrameTrouble::kindName() const {
 std::string FrameTrouble::text() const {
     char buf[256];
     if (kind == Kind::OverStretch)
-        std::snprintf(buf, sizeof buf, "over-stretched: edge %d-%d at %.3g× its rest length (limit %g×)",
-                      vertex, other, amount, limit);
+        std::snprintf(buf, sizeof buf,
+                      "over-stretched: edge %d-%d at %.3g× its rest length (limit %g×)", vertex,
+                      other, amount, limit);
     else
         std::snprintf(buf, sizeof buf, "inside a collider: vertex %d %.3g mm below its surface",
                       vertex, 1e3 * amount);
