@@ -180,12 +180,15 @@ double Body::maxEdgeStretch() const {
     return maxEdgeStretchOf(mX);
 }
 
+double Body::edgeStretchOf(const VecX& x, size_t e) const {
+    if (!(mEdgeRest[e] > 0.0)) return 0.0;
+    return (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
+}
+
 double Body::maxEdgeStretchOf(const VecX& x) const {
     double m = 0.0;
     for (size_t e = 0; e < mEdges.size(); ++e) {
-        if (!(mEdgeRest[e] > 0.0)) continue;
-        const double r =
-            (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];
+        const double r = edgeStretchOf(x, e);
         if (std::isnan(r)) return r; // a non-finite state is never "not stretched"
         m = std::max(m, r);
     }

@@ -255,7 +255,8 @@ public:
     double maxEdgeStretch() const;                     // max |e| / |e_rest|
     double maxEdgeStretchOf(const VecX& x) const;      // the same at positions x (NaN if any is)
     const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
-    const std::vector<double>& edgeRestLengths() const { return mEdgeRest; } // m, per edge
+    // Edge e's length at positions x over its rest length (0 for an edge of zero rest length).
+    double edgeStretchOf(const VecX& x, size_t e) const;
     // Whether pin k (pinnedVertices()[k]) follows an attachment (a body's surface), not a pin.
     bool pinIsAttachment(size_t k) const { return k < mPinBinding.size() && mPinBinding[k]; }
 

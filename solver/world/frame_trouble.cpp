@@ -79,13 +79,11 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
 
     // ---- over-stretch: r_e = |x_j − x_i| / L_e > over_stretch ----
     const auto& edges = body.edges();
-    const std::vector<double>& rest = body.edgeRestLengths();
     FrameTrouble s;
     s.kind = FrameTrouble::Kind::OverStretch;
     s.limit = overStretch;
     for (size_t e = 0; e < edges.size(); ++e) {
-        if (!(rest[e] > 0.0)) continue;
-        const double r = (pos(edges[e][1]) - pos(edges[e][0])).norm() / rest[e];
+        const double r = body.edgeStretchOf(x, e);
         if (!(r > overStretch)) continue;
         ++s.count;
         if (r > s.amount) {
