@@ -21,9 +21,11 @@ struct FrameTrouble {
     double amount = 0.0;          // the edge's length / rest length, or the depth inside (m)
     double limit = 0.0;           // over_stretch, or the depth tolerated (m)
     int count = 0;                // edges (vertices) of the body in this trouble at the frame
-    std::string forcedBy;         // "pins", "pin", "attachment", "collider 'ball'", "the solver"
+    // "pins" / "attachments" / "a pin and an attachment" (both ends held), "the pin at vertex 7",
+    // "collider 'ball'" (and, inside, " and the pin holding vertex 7 inside it"), "the solver".
+    std::string forcedBy;
     bool scene = false; // forced by the scene (held vertices pulled apart, or held inside)
-    // One line for stderr and run.json's events, e.g. "over-stretched: edge 12–13 at 4.1× its
+    // One line for stderr and run.json's events, e.g. "over-stretched: edge 12-13 at 4.1× its
     // rest length (limit 3×) at (0.1, 0.9, 0), forced by collider 'ball'".
     std::string text() const;
     const char* kindName() const;
