@@ -23,6 +23,9 @@ struct SceneSettings {
     // scene.time_zero: the frame at which $t = 0 (studio shots start at 1001): $t, wind and
     // gust keys and mesh sequences are shot time, $frame the studio frame number.
     double timeZero = 0.0;
+    // scene.preroll: frames simulated before the first and not written, mesh-sequence bodies eased
+    // from their rest pose to their pose at the first frame (run/sim_run.h).
+    int preroll = 0;
     // Seconds at `frame` (the end of that frame's step).
     double frameTime(double frame) const { return (frame - timeZero) / fps; }
 };

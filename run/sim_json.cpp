@@ -55,10 +55,10 @@ std::string settingsJson(const scene::SimScene& sc,
     std::ostringstream o;
     o << "{\"scene\": " << jsonString(sc.wind.path) << ", \"sets\": [";
     for (size_t i = 0; i < sets.size(); ++i) o << (i ? ", " : "") << jsonString(sets[i]);
-    o << "], \"fps\": " << num(s.fps) << ", \"time_zero\": " << num(s.timeZero)
-      << ", \"frames\": [" << first << ", " << last << "], \"substeps\": " << s.substeps
-      << ", \"gravity\": " << vec(s.gravity) << ", \"air_density\": " << num(s.airDensity)
-      << ", \"threads\": " << threads
+    o << "], \"fps\": " << num(s.fps) << ", \"time_zero\": " << num(s.timeZero) << ", \"frames\": ["
+      << first << ", " << last << "], \"preroll\": " << s.preroll
+      << ", \"substeps\": " << s.substeps << ", \"gravity\": " << vec(s.gravity)
+      << ", \"air_density\": " << num(s.airDensity) << ", \"threads\": " << threads
       << ", \"solver\": {\"max_halvings\": " << sc.solver.maxHalvings
       << ", \"over_stretch\": " << num(sc.solver.overStretch)
       << ", \"velocity_jump\": " << num(sc.solver.velocityJump) << "}";

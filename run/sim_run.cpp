@@ -110,9 +110,12 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     std::vector<std::string> warnings;
     mFirst = s.hasFrames ? s.first : mScene.wind.settings.frameStart;
     mLast = s.hasFrames ? s.last : mScene.wind.settings.frameEnd;
-    mRunUpFrom = std::min(mFirst, mScene.wind.settings.frameStart);
-    // Attachments bind against their bodies where the simulation starts: the run-up's first
-    // frame when the range starts mid-shot (its frames are simulated first), else first().
+    // The pre-roll ends where the shot (or an earlier --frames range) starts; a range that starts
+    // mid-shot simulates from there too. Attachments bind against their bodies where the
+    // simulation starts: the run-up's first frame (the bodies' rest pose under a pre-roll).
+    const int shotStart = std::min(mFirst, mScene.wind.settings.frameStart);
+    mRunUpFrom = shotStart - mScene.wind.settings.preroll;
+    if (!scene::prerollSequences(mScene, shotStart, errors)) return sceneErrors(errors);
     if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths, mRunUpFrom))
         return sceneErrors(errors);
     for (const std::string& w : warnings) report += "gale: warning: " + w + '\n';

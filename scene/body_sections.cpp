@@ -46,8 +46,9 @@ const std::vector<std::string> kClothKeys =
 const std::vector<std::string> kHairKeys =
     withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
                   "drag_normal", "drag_tangent", "root_pinned", "rest_shape", "attach"});
-const std::vector<std::string> kColliderKeys = {"name", "type", "center", "radius", "point", "normal",
-                                                "a", "b", "thickness", "friction", "mesh", "voxel"};
+const std::vector<std::string> kColliderKeys = {
+    "name", "type",      "center",   "radius", "point", "normal",   "a",
+    "b",    "thickness", "friction", "mesh",   "voxel", "rest_mesh"};
 const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
 
 class Loader : public TomlReader {
@@ -76,7 +77,7 @@ private:
     void loadCloth(const toml::table& t, size_t index, const std::string& baseDir, ClothSpec& c);
     void loadHair(const toml::table& t, size_t index, const std::string& baseDir, HairSpec& h);
     void loadCollider(const toml::table& t, size_t index, const fields::SceneSettings& settings,
-                      Collider& c);
+                      std::vector<double>& rest, Collider& c);
     void loadSolver(const toml::table& t, SolverSection& s);
 };
 
@@ -582,7 +583,7 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
 }
 
 void Loader::loadCollider(const toml::table& t, size_t index, const fields::SceneSettings& settings,
-                          Collider& c) {
+                          std::vector<double>& rest, Collider& c) {
     c.name = "collider" + std::to_string(index);
     c.line = static_cast<int>(t.source().begin.line);
     c.col = static_cast<int>(t.source().begin.column);
@@ -605,7 +606,7 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
                                           : type == "mesh"   ? std::vector<std::string>{"mesh"}
                                                              : std::vector<std::string>{"a", "b", "radius"};
     std::vector<std::string> allowed = {"name", "type", "thickness", "friction"};
-    if (type == "mesh") allowed.push_back("voxel");
+    if (type == "mesh") allowed.insert(allowed.end(), {"voxel", "rest_mesh"});
     allowed.insert(allowed.end(), need.begin(), need.end());
     for (auto&& [key, node] : t) {
         const std::string k(key.str());
@@ -646,9 +647,39 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
             error(*mesh, what + ": " + problem);
             return;
         }
+        if (const toml::node* r = t.get("rest_mesh")) {
+            // The rest (bind) pose the pre-roll eases the body from (scene.preroll).
+            std::string restFile;
+            if (!string(*r, what + ": rest_mesh", restFile)) return;
+            const std::filesystem::path rp(restFile);
+            const std::string restPath =
+                rp.is_absolute()
+                    ? restFile
+                    : (std::filesystem::path(mPath).parent_path() / rp).lexically_normal().string();
+            TriMesh m;
+            if (!loadMesh(restPath, m, problem)) {
+                error(*r, what + ": rest_mesh: " + problem);
+                return;
+            }
+            if (m.vertexCount() != seq->vertexCount() || m.triangles != seq->triangles()) {
+                error(*r,
+                      what + ": rest_mesh '" + restFile + "' has " +
+                          std::to_string(m.vertexCount()) + " vertices and " +
+                          std::to_string(m.triangles.size()) + " triangles, the sequence " +
+                          std::to_string(seq->vertexCount()) + " and " +
+                          std::to_string(seq->triangles().size()) +
+                          ": the rest pose needs the sequence's topology (the same mesh, unposed)");
+                return;
+            }
+            rest = std::move(m.positions);
+        }
         c.moving = std::make_shared<MovingMeshContact>(std::move(seq));
         return;
     }
+    if (const toml::node* r = t.get("rest_mesh"))
+        error(*r, what +
+                      ": rest_mesh is the rest pose of a mesh sequence ('#', %04d or $F4 in mesh); "
+                      "a static mesh does not move");
     c.mesh = MeshCollider::load(path, voxel, problem);
     if (!c.mesh) error(*mesh, what + ": " + problem);
 }
@@ -694,8 +725,10 @@ void Loader::load(const toml::table& root, const std::string& baseDir, SimScene&
     });
     list("collider", [&](const toml::table& t, size_t i) {
         Collider c;
-        loadCollider(t, i, out.wind.settings, c);
+        std::vector<double> rest;
+        loadCollider(t, i, out.wind.settings, rest, c);
         out.colliders.push_back(std::move(c));
+        out.colliderRest.push_back(std::move(rest));
     });
     if (const toml::node* n = root.get("solver")) {
         if (const toml::table* t = n->as_table())

@@ -3,9 +3,11 @@
 // and the output geometry (OBJ text, PLY point sets) of a body's current shape.
 #include "scene/sim_scene.h"
 
+#include "solver/collider/moving_collider.h"
 #include "solver/mesh/mesh_sequence.h"
 
 #include "fields/expression_field.h"
+#include "io/frame_pattern.h"
 #include "lang/diagnostics.h"
 #include "runtime/program.h"
 
@@ -205,7 +207,56 @@ std::shared_ptr<const MeshSequence> loadSequence(const std::string& path,
     return s;
 }
 
+// One key for the spellings of one sequence (`body.#.obj`, `body.%04d.obj`, `body.$F4.obj`).
+std::string sequenceKey(const std::string& path) {
+    const std::filesystem::path p = std::filesystem::path(path).lexically_normal();
+    io::FramePattern fp;
+    if (!io::parseFramePattern(p.filename().string(), fp)) return p.string();
+    return (p.parent_path() / (fp.prefix + "<" + std::to_string(fp.width) + ">" + fp.suffix))
+        .string();
+}
+
+// An attachment's sequence: the collider's eased one of the same files, else loaded (and eased
+// from its first file under a pre-roll).
+std::shared_ptr<const MeshSequence> attachSequence(const SimScene& scene, const std::string& path,
+                                                   std::string& error) {
+    auto found = scene.eased.find(sequenceKey(path));
+    if (found != scene.eased.end()) return found->second;
+    std::shared_ptr<const MeshSequence> seq = loadSequence(path, scene.wind.settings, error);
+    const fields::SceneSettings& s = scene.wind.settings;
+    if (!seq || scene.prerollTo == INT_MIN || s.preroll <= 0) return seq;
+    return seq->eased(seq->firstPositions(), s.frameTime(scene.prerollTo - s.preroll),
+                      s.frameTime(scene.prerollTo), error);
+}
+
 } // namespace
+
+bool prerollSequences(SimScene& scene, int toFrame, std::vector<SceneError>& errors) {
+    const fields::SceneSettings& s = scene.wind.settings;
+    if (s.preroll <= 0) return true;
+    scene.prerollTo = toFrame;
+    bool ok = true;
+    for (size_t i = 0; i < scene.colliders.size(); ++i) {
+        solver::Collider& c = scene.colliders[i];
+        if (!c.moving) continue;
+        const MeshSequence& seq = c.moving->mesh();
+        const std::vector<double>& rest =
+            i < scene.colliderRest.size() && !scene.colliderRest[i].empty() ? scene.colliderRest[i]
+                                                                            : seq.firstPositions();
+        std::string problem;
+        std::shared_ptr<const MeshSequence> eased =
+            seq.eased(rest, s.frameTime(toFrame - s.preroll), s.frameTime(toFrame), problem);
+        if (!eased) {
+            errors.push_back(sceneError(scene, c.line, c.col,
+                                        "[[collider]] '" + c.name + "': pre-roll: " + problem));
+            ok = false;
+            continue;
+        }
+        scene.eased.emplace(sequenceKey(seq.path()), eased);
+        c.moving = std::make_shared<solver::MovingMeshContact>(std::move(eased));
+    }
+    return ok;
+}
 
 WorldSettings worldSettings(const SimScene& scene, int threads) {
     WorldSettings ws;
@@ -353,7 +404,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         if (spec.hasAttach) {
             PinSet att;
             std::string problem;
-            att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
+            att.attach = attachSequence(scene, spec.attachMesh, problem);
             att.bindTime = bindTime;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
@@ -423,7 +474,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         std::vector<int> otherRoots;
         if (spec.hasAttach) {
             std::string problem;
-            att.attach = loadSequence(spec.attachMesh, scene.wind.settings, problem);
+            att.attach = attachSequence(scene, spec.attachMesh, problem);
             att.bindTime = bindTime;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,

@@ -12,6 +12,7 @@
 #include "solver/bodies/hair.h"
 #include "solver/world/world.h"
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -103,7 +104,21 @@ struct SimScene {
     std::vector<ClothSpec> cloths;
     std::vector<HairSpec> hairs;
     std::vector<solver::Collider> colliders;
+    // Per collider: the rest pose its pre-roll eases from (a sequence's rest_mesh; empty: the
+    // sequence's first file).
+    std::vector<std::vector<double>> colliderRest;
+    // Set by prerollSequences: the frame the pre-roll ends at (INT_MIN: no pre-roll) and the eased
+    // sequences by their files (any spelling of the pattern), shared by the colliders and the
+    // attachments that name them.
+    int prerollTo = INT_MIN;
+    std::map<std::string, std::shared_ptr<const solver::MeshSequence>> eased;
 };
+
+// scene.preroll: eases every mesh-sequence collider from its rest pose (held until frame
+// toFrame − preroll) to its pose and velocity at `toFrame`, where the written frames start
+// (solver::MeshSequence::eased); buildBodies eases attachment sequences the same way. Nothing
+// without a pre-roll. False, with errors at the collider, when a rest pose does not fit.
+bool prerollSequences(SimScene& scene, int toFrame, std::vector<SceneError>& errors);
 
 // Loads meshes and strands, evaluates painted maps and pins, and makes the bodies. Problems
 // (a missing mesh, an unknown map, an expression error) come back as errors at the place in

@@ -136,7 +136,8 @@ void Loader::verbatimPosition(const toml::node& n, const std::string& value, int
 // ---- Sections ---------------------------------------------------------------------------------
 
 void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
-    checkKeys(t, {"fps", "frames", "substeps", "gravity", "air_density", "time_zero"}, "[scene]");
+    checkKeys(t, {"fps", "frames", "substeps", "gravity", "air_density", "time_zero", "preroll"},
+              "[scene]");
     if (const toml::node* n = t.get("fps")) {
         double v = 0.0;
         if (number(*n, "scene.fps", v)) {
@@ -171,6 +172,17 @@ void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
                 s.timeZero = v;
             else
                 error(*n, "scene.time_zero must stay within +/-100000000 (a frame number)");
+        }
+    }
+    if (const toml::node* n = t.get("preroll")) {
+        long long v = 0;
+        if (integer(*n, "scene.preroll (frames simulated before the first)", v)) {
+            if (v >= 0 && v <= 100000)
+                s.preroll = static_cast<int>(v);
+            else
+                error(*n,
+                      "scene.preroll must be between 0 and 100000 frames (e.g. 24: one second at "
+                      "24 fps)");
         }
     }
     if (const toml::node* n = t.get("substeps")) {

@@ -105,11 +105,15 @@ int runSim(const SimOptions& o) {
 
     const int first = sim.first(), last = sim.last();
     if (out.nextFrame() == first && sim.runUpFrames() > 0) {
-        // A range that starts mid-shot starts from the simulated state there, not a teleport.
+        // A range that starts mid-shot starts from the simulated state there, not a teleport;
+        // a pre-roll eases the bodies from their rest pose first.
         const int from = first - sim.runUpFrames();
+        const int preroll = sim.scene().wind.settings.preroll;
         std::cerr << "gale: frames " << from << "-" << first
-                  << " are simulated first and not written: frame " << first
-                  << " starts from a simulated state\n";
+                  << " are simulated first and not written";
+        if (preroll > 0)
+            std::cerr << " (" << preroll << " of pre-roll, the bodies eased from their rest pose)";
+        std::cerr << ": frame " << first << " starts from a simulated state\n";
         Progress runUp(sim.runUpFrames());
         int step = 0;
         solver::FrameStats failed;

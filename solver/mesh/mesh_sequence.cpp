@@ -7,6 +7,7 @@
 #include "solver/contact/ccd.h"
 #include "solver/mesh/mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -15,8 +16,9 @@ namespace gale::solver {
 MeshSequence::MeshSequence(std::vector<std::array<int, 3>> triangles,
                            std::vector<std::vector<double>> frames, long firstFrame, double fps,
                            double frameZero)
-    : mTriangles(std::move(triangles)), mFrames(std::move(frames)), mFirstFrame(firstFrame),
-      mFps(fps), mFrameZero(frameZero) {}
+    : mTriangles(std::move(triangles)),
+      mFrames(std::make_shared<const std::vector<std::vector<double>>>(std::move(frames))),
+      mFirstFrame(firstFrame), mFps(fps), mFrameZero(frameZero) {}
 
 std::shared_ptr<const MeshSequence> MeshSequence::load(const std::string& path, double fps,
                                                        std::string& error, double frameZero) {
@@ -83,34 +85,104 @@ std::shared_ptr<const MeshSequence> MeshSequence::load(const std::string& path, 
     return seq;
 }
 
-void MeshSequence::positionsAt(double t, std::vector<double>& out) const {
+void MeshSequence::rawPositionsAt(double t, std::vector<double>& out) const {
+    const std::vector<std::vector<double>>& frames = *mFrames;
     const double f = t * mFps - (static_cast<double>(mFirstFrame) - mFrameZero);
-    const long last = static_cast<long>(mFrames.size()) - 1;
+    const long last = static_cast<long>(frames.size()) - 1;
     if (last <= 0 || !(f > 0.0)) {
-        out = mFrames.front();
+        out = frames.front();
         return;
     }
     if (f >= static_cast<double>(last)) {
-        out = mFrames.back();
+        out = frames.back();
         return;
     }
     const long a = static_cast<long>(std::floor(f));
     const double w = f - static_cast<double>(a);
-    const std::vector<double>& pa = mFrames[a];
-    const std::vector<double>& pb = mFrames[a + 1];
+    const std::vector<double>& pa = frames[a];
+    const std::vector<double>& pb = frames[a + 1];
     out.resize(pa.size());
     for (size_t i = 0; i < pa.size(); ++i) out[i] = pa[i] + w * (pb[i] - pa[i]);
 }
 
-Vec3 MeshSequence::vertexAt(int v, double t) const {
+Vec3 MeshSequence::rawVertexAt(int v, double t) const {
+    const std::vector<std::vector<double>>& frames = *mFrames;
     const double f = t * mFps - (static_cast<double>(mFirstFrame) - mFrameZero);
-    const long last = static_cast<long>(mFrames.size()) - 1;
-    if (last <= 0 || !(f > 0.0)) return vec3At(mFrames.front().data(), v);
-    if (f >= static_cast<double>(last)) return vec3At(mFrames.back().data(), v);
+    const long last = static_cast<long>(frames.size()) - 1;
+    if (last <= 0 || !(f > 0.0)) return vec3At(frames.front().data(), v);
+    if (f >= static_cast<double>(last)) return vec3At(frames.back().data(), v);
     const long a = static_cast<long>(std::floor(f));
     const double w = f - static_cast<double>(a);
-    const Vec3 pa = vec3At(mFrames[a].data(), v), pb = vec3At(mFrames[a + 1].data(), v);
+    const Vec3 pa = vec3At(frames[a].data(), v), pb = vec3At(frames[a + 1].data(), v);
     return pa + w * (pb - pa);
+}
+
+namespace {
+// The Hermite weights of the pre-roll at u = (t − from)/T ∈ [0, 1]: h(u) = 3u² − 2u³ on p − r
+// (0 → 1, flat at both ends) and g(u) = u³ − u² on T·v (0 at both ends, slope 1 at u = 1).
+void easeWeights(double u, double& h, double& g) {
+    u = std::clamp(u, 0.0, 1.0);
+    h = u * u * (3.0 - 2.0 * u);
+    g = u * u * (u - 1.0);
+}
+} // namespace
+
+void MeshSequence::positionsAt(double t, std::vector<double>& out) const {
+    if (!mEase || !(t < mEase->to)) {
+        rawPositionsAt(t, out);
+        return;
+    }
+    double h = 0.0, g = 0.0;
+    easeWeights((t - mEase->from) / (mEase->to - mEase->from), h, g);
+    const Ease& e = *mEase;
+    out.resize(e.rest.size());
+    for (size_t i = 0; i < out.size(); ++i) out[i] = e.rest[i] + h * e.dp[i] + g * e.dv[i];
+}
+
+Vec3 MeshSequence::vertexAt(int v, double t) const {
+    if (!mEase || !(t < mEase->to)) return rawVertexAt(v, t);
+    double h = 0.0, g = 0.0;
+    easeWeights((t - mEase->from) / (mEase->to - mEase->from), h, g);
+    const Ease& e = *mEase;
+    return vec3At(e.rest.data(), v) + h * vec3At(e.dp.data(), v) + g * vec3At(e.dv.data(), v);
+}
+
+std::shared_ptr<const MeshSequence> MeshSequence::eased(std::vector<double> rest, double from,
+                                                        double to, std::string& error) const {
+    if (rest.size() != mFrames->front().size()) {
+        error = "the rest pose has " + std::to_string(rest.size() / 3) +
+                " vertices, the sequence " + std::to_string(vertexCount()) +
+                ": it needs the sequence's topology";
+        return nullptr;
+    }
+    if (!(from < to)) {
+        error = "the pre-roll must end after it starts";
+        return nullptr;
+    }
+    for (double x : rest)
+        if (!std::isfinite(x)) {
+            error = "a vertex of the rest pose is not finite";
+            return nullptr;
+        }
+    auto e = std::make_shared<Ease>();
+    e->from = from;
+    e->to = to;
+    // p: the pose at `to`; v: the velocity of the frame after it (0 where the sequence is held).
+    std::vector<double> p, next;
+    rawPositionsAt(to, p);
+    const double frame = 1.0 / mFps;
+    rawPositionsAt(to + frame, next);
+    const double span = to - from;
+    e->dp.resize(p.size());
+    e->dv.resize(p.size());
+    for (size_t i = 0; i < p.size(); ++i) {
+        e->dp[i] = p[i] - rest[i];
+        e->dv[i] = span * (next[i] - p[i]) / frame;
+    }
+    e->rest = std::move(rest);
+    auto seq = std::make_shared<MeshSequence>(*this);
+    seq->mEase = std::move(e);
+    return seq;
 }
 
 namespace {

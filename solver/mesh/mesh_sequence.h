@@ -1,7 +1,8 @@
 // Animated triangle meshes from per-frame files (`body.#.obj` -> body.0001.obj, ..., OBJ or PLY;
 // the `#` rule of vdb() and meshvel(), geometry/file_policy.h): one topology for every frame,
-// positions linear in time within a frame (frame F at t = (F − time_zero) / fps), held before the first and
-// after the last. A plain file name is a one-frame (static) sequence.
+// positions linear in time within a frame (frame F at t = (F − time_zero) / fps), held before the
+// first and after the last. A plain file name is a one-frame (static) sequence. A pre-rolled copy
+// (scene.preroll) eases from a rest pose to the sequence's pose and velocity at the shot's start.
 #pragma once
 
 #include <cmath>
@@ -27,28 +28,48 @@ public:
     MeshSequence(std::vector<std::array<int, 3>> triangles, std::vector<std::vector<double>> frames,
                  long firstFrame, double fps, double frameZero = 0.0);
 
-    size_t vertexCount() const { return mFrames.empty() ? 0 : mFrames[0].size() / 3; }
+    // A copy (sharing the frames) that, before `to` (s), eases from `rest` (3 per vertex; the rest
+    // pose) held until `from` to this sequence's pose and velocity at `to` — a cubic Hermite in
+    // time, x(u) = r + (3u² − 2u³)(p − r) + (u³ − u²)·T·v with u = (t − from)/T, T = to − from, p
+    // and v the pose at `to` and the velocity of the frame after it — so that positions and
+    // velocities are continuous where the shot starts (scene.preroll). Null with `error` when
+    // `rest` has another vertex count or from ≥ to.
+    std::shared_ptr<const MeshSequence> eased(std::vector<double> rest, double from, double to,
+                                              std::string& error) const;
+    bool isEased() const { return static_cast<bool>(mEase); }
+
+    size_t vertexCount() const { return mFrames->empty() ? 0 : mFrames->front().size() / 3; }
     const std::vector<std::array<int, 3>>& triangles() const { return mTriangles; }
-    size_t frameCount() const { return mFrames.size(); }
+    size_t frameCount() const { return mFrames->size(); }
     long firstFrame() const { return mFirstFrame; }
-    long lastFrame() const { return mFirstFrame + static_cast<long>(mFrames.size()) - 1; }
+    long lastFrame() const { return mFirstFrame + static_cast<long>(mFrames->size()) - 1; }
     double frameZero() const { return mFrameZero; }
     // Seconds at frame F of the sequence.
     double frameTime(double frame) const { return (frame - mFrameZero) / mFps; }
     double fps() const { return mFps; }
-    bool moving() const { return mFrames.size() > 1; }
+    bool moving() const { return mFrames->size() > 1 || mEase; }
     const std::string& path() const { return mPath; }
 
     // Vertex positions at time t (3 per vertex), linear between the two frames around t·fps.
     void positionsAt(double t, std::vector<double>& out) const;
     // The positions of the first frame (the bind pose of attachments).
-    const std::vector<double>& firstPositions() const { return mFrames.front(); }
+    const std::vector<double>& firstPositions() const { return mFrames->front(); }
     // One vertex at time t (the same interpolation as positionsAt).
     Vec3 vertexAt(int v, double t) const;
 
 private:
+    // The pre-roll (eased()): x(t) = rest + h(u)·dp + g(u)·dv for t < to.
+    struct Ease {
+        double from = 0.0, to = 0.0;
+        std::vector<double> rest, dp, dv; // r, p − r, T·v (3 per vertex)
+    };
+    // The sequence as loaded, without the pre-roll.
+    void rawPositionsAt(double t, std::vector<double>& out) const;
+    Vec3 rawVertexAt(int v, double t) const;
+
     std::vector<std::array<int, 3>> mTriangles;
-    std::vector<std::vector<double>> mFrames;
+    std::shared_ptr<const std::vector<std::vector<double>>> mFrames;
+    std::shared_ptr<const Ease> mEase;
     long mFirstFrame = 0;
     double mFps = 24.0;
     double mFrameZero = 0.0;

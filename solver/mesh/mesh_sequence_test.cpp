@@ -76,3 +76,66 @@ TEST_CASE("mesh sequence: a missing frame or a changed topology names the file",
     CHECK_FALSE(MeshSequence::load((d.path / "none.#.obj").string(), 24.0, error));
     CHECK(error.find("none.#.obj") != std::string::npos);
 }
+
+TEST_CASE("mesh sequence: the pre-roll eases from the rest pose to the pose and velocity at the "
+          "shot's start, C1 at both ends",
+          "[mesh][sequence][preroll]") {
+    // One triangle moving at 0.24 m/s along x (0.01 m per frame at 24 fps) from frame 10 on;
+    // its rest pose is the same triangle 1 m up.
+    const double fps = 24.0;
+    std::vector<std::vector<double>> frames;
+    for (int k = 0; k < 6; ++k) {
+        const double x = 0.01 * k;
+        frames.push_back({x, 0, 0, x + 1, 0, 0, x, 1, 0});
+    }
+    const MeshSequence seq({{0, 1, 2}}, frames, 10, fps);
+    std::vector<double> rest = frames[0];
+    for (size_t i = 1; i < rest.size(); i += 3) rest[i] += 1.0;
+    const double from = 4.0 / fps, to = 10.0 / fps, T = to - from; // six frames of pre-roll
+    std::string error;
+    auto eased = seq.eased(rest, from, to, error);
+    INFO(error);
+    REQUIRE(eased);
+    CHECK(eased->moving());
+    CHECK(eased->frameCount() == seq.frameCount());
+    std::vector<double> p, q;
+    // Held at rest before `from`, exactly the rest pose there.
+    eased->positionsAt(0.0, p);
+    CHECK(p == rest);
+    eased->positionsAt(from, p);
+    CHECK(p == rest);
+    // At and after `to`: the sequence itself.
+    for (double t : {to, to + 0.5 / fps, to + 3.25 / fps}) {
+        eased->positionsAt(t, p);
+        seq.positionsAt(t, q);
+        for (size_t i = 0; i < p.size(); ++i) CHECK(p[i] == Approx(q[i]).margin(1e-15));
+    }
+    // Halfway: h = 1/2, g = −1/8, so x = r + (p − r)/2 − T·v/8 (closed form).
+    eased->positionsAt(from + 0.5 * T, p);
+    const double v = 0.01 * fps;
+    CHECK(p[0] == Approx(0.0 - T * v / 8.0));
+    CHECK(p[1] == Approx(1.0 - 0.5));
+    CHECK(p[2] == Approx(0.0));
+    // Velocities (central differences; the acceleration's jump at the ends costs O(d)) continuous:
+    // 0 leaving the rest pose, v arriving at `to` — against (p − r)/T = 4 m/s a jump would be O(1).
+    const double d = 1e-6;
+    auto velocity = [&](int coord, double t) {
+        return (eased->vertexAt(0, t + d)[coord] - eased->vertexAt(0, t - d)[coord]) / (2.0 * d);
+    };
+    CHECK(velocity(0, from) == Approx(0.0).margin(1e-4));
+    CHECK(velocity(1, from) == Approx(0.0).margin(1e-4));
+    CHECK(velocity(0, to) == Approx(v).margin(1e-4));
+    CHECK(velocity(1, to) == Approx(0.0).margin(1e-4));
+    // vertexAt and positionsAt agree inside the pre-roll.
+    eased->positionsAt(from + 0.3 * T, p);
+    for (int vtx = 0; vtx < 3; ++vtx)
+        for (int c = 0; c < 3; ++c)
+            CHECK(eased->vertexAt(vtx, from + 0.3 * T)[c] == Approx(p[3 * vtx + c]));
+    // The original is untouched.
+    seq.positionsAt(from, p);
+    CHECK(p == frames[0]);
+    // A rest pose of another size, or an empty window, is refused.
+    CHECK_FALSE(seq.eased({0, 0, 0}, from, to, error));
+    CHECK(error.find("vertices") != std::string::npos);
+    CHECK_FALSE(seq.eased(rest, to, to, error));
+}
