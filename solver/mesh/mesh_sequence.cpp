@@ -18,7 +18,9 @@ MeshSequence::MeshSequence(std::vector<std::array<int, 3>> triangles,
                            double frameZero)
     : mTriangles(std::move(triangles)),
       mFrames(std::make_shared<const std::vector<std::vector<double>>>(std::move(frames))),
-      mFirstFrame(firstFrame), mFps(fps), mFrameZero(frameZero) {}
+      mFirstFrame(firstFrame), mFps(fps), mFrameZero(frameZero) {
+    buildCorners();
+}
 
 std::shared_ptr<const MeshSequence> MeshSequence::load(const std::string& path, double fps,
                                                        std::string& error, double frameZero) {
@@ -185,18 +187,91 @@ std::shared_ptr<const MeshSequence> MeshSequence::eased(std::vector<double> rest
     return seq;
 }
 
-namespace {
-// The triangle's frame (ê₁, n̂ × ê₁, n̂) as columns.
-Mat3 triangleFrame(const Vec3& a, const Vec3& b, const Vec3& c) {
-    Mat3 f = Mat3::Identity();
-    const Vec3 e = b - a, n = e.cross(c - a);
-    if (!(e.norm() > 0.0) || !(n.norm() > 0.0)) return f;
-    f.col(0) = e.normalized();
-    f.col(2) = n.normalized();
-    f.col(1) = f.col(2).cross(f.col(0));
-    return f;
+void MeshSequence::buildCorners() {
+    const size_t nv = vertexCount();
+    mCornerStart.assign(nv + 1, 0);
+    for (const auto& t : mTriangles)
+        for (int v : t)
+            if (v >= 0 && static_cast<size_t>(v) < nv) ++mCornerStart[v + 1];
+    for (size_t v = 0; v < nv; ++v) mCornerStart[v + 1] += mCornerStart[v];
+    mCorners.assign(mCornerStart[nv], Corner{0, 0});
+    std::vector<size_t> fill(mCornerStart.begin(), mCornerStart.end() - 1);
+    for (size_t k = 0; k < mTriangles.size(); ++k)
+        for (int c = 0; c < 3; ++c) {
+            const int v = mTriangles[k][c];
+            if (v >= 0 && static_cast<size_t>(v) < nv)
+                mCorners[fill[v]++] = Corner{static_cast<int>(k), c};
+        }
 }
+
+namespace {
+
+Vec3 unitFaceNormal(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 n = (b - a).cross(c - a);
+    const double len = n.norm();
+    return len > 0.0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+// The angle-weighted normal of vertex v with positions from `pos(vertex)`.
+template <class Pos>
+Vec3 angleWeightedNormal(const MeshSequence& m, int v, const Pos& pos) {
+    Vec3 sum = Vec3::Zero();
+    for (const MeshSequence::Corner* c = m.cornersBegin(v); c != m.cornersEnd(v); ++c) {
+        const auto& t = m.triangles()[c->triangle];
+        const Vec3 p = pos(t[c->corner]), a = pos(t[(c->corner + 1) % 3]),
+                   b = pos(t[(c->corner + 2) % 3]);
+        const Vec3 ea = a - p, eb = b - p;
+        const double la = ea.norm(), lb = eb.norm();
+        if (!(la > 0.0) || !(lb > 0.0)) continue;
+        const double angle = std::acos(std::clamp(ea.dot(eb) / (la * lb), -1.0, 1.0));
+        sum += angle * unitFaceNormal(p, a, b);
+    }
+    const double len = sum.norm();
+    return len > 0.0 ? Vec3(sum / len) : Vec3::Zero();
+}
+
+// n_s(w): the vertex normals of triangle `tri` blended by the weights clamped to the triangle.
+template <class Pos>
+Vec3 smoothNormal(const MeshSequence& m, int tri, const double w[3], const Pos& pos) {
+    double c[3], sum = 0.0;
+    for (int k = 0; k < 3; ++k) sum += (c[k] = std::max(w[k], 0.0));
+    Vec3 n = Vec3::Zero();
+    const auto& t = m.triangles()[tri];
+    for (int k = 0; k < 3; ++k)
+        if (c[k] > 0.0) n += (c[k] / sum) * angleWeightedNormal(m, t[k], pos);
+    const double len = n.norm();
+    return len > 0.0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+// Barycentric weights of y's projection onto the plane of (a, b, c) (outside it too).
+void planeWeights(const Vec3& y, const Vec3& a, const Vec3& b, const Vec3& c, double w[3]) {
+    const Vec3 e0 = b - a, e1 = c - a, e2 = y - a;
+    const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+    const double d20 = e2.dot(e0), d21 = e2.dot(e1), den = d00 * d11 - d01 * d01;
+    if (!(den > 0.0)) {
+        w[0] = 1.0;
+        w[1] = w[2] = 0.0;
+        return;
+    }
+    w[1] = (d11 * d20 - d01 * d21) / den;
+    w[2] = (d00 * d21 - d01 * d20) / den;
+    w[0] = 1.0 - w[1] - w[2];
+}
+
+template <class Pos>
+Vec3 bound(const MeshSequence& m, const SurfaceBinding& b, const Pos& pos) {
+    const auto& t = m.triangles()[b.triangle];
+    const Vec3 a = pos(t[0]), bb = pos(t[1]), c = pos(t[2]);
+    const Vec3 y = b.w[0] * a + b.w[1] * bb + b.w[2] * c;
+    const Vec3 n = b.alongFace ? unitFaceNormal(a, bb, c) : smoothNormal(m, b.triangle, b.w, pos);
+    return y + b.height * n;
+}
+
 } // namespace
+
+Vec3 MeshSequence::vertexNormalAt(int v, double t) const {
+    return angleWeightedNormal(*this, v, [&](int k) { return vertexAt(k, t); });
+}
 
 SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double when) {
     SurfaceBinding b;
@@ -208,11 +283,11 @@ SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double whe
         for (size_t v = 0; v < nv; ++v) vec3At(at.data(), v) = mesh.vertexAt(static_cast<int>(v), when);
     }
     const std::vector<double>& p = std::isfinite(when) ? at : mesh.firstPositions();
+    const auto pos = [&](int v) { return Vec3(vec3At(p.data(), v)); };
     for (size_t k = 0; k < mesh.triangles().size(); ++k) {
         const auto& t = mesh.triangles()[k];
         double w[3];
-        const double d2 = contact::pointTriangleDistance2(x, vec3At(p.data(), t[0]), vec3At(p.data(), t[1]),
-                                                          vec3At(p.data(), t[2]), w);
+        const double d2 = contact::pointTriangleDistance2(x, pos(t[0]), pos(t[1]), pos(t[2]), w);
         if (d2 < best) {
             best = d2;
             b.triangle = static_cast<int>(k);
@@ -221,16 +296,29 @@ SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double whe
     }
     if (b.triangle < 0) return b;
     const auto& t = mesh.triangles()[b.triangle];
-    const Vec3 a = vec3At(p.data(), t[0]), bb = vec3At(p.data(), t[1]), c = vec3At(p.data(), t[2]);
-    const Vec3 q = b.w[0] * a + b.w[1] * bb + b.w[2] * c;
-    b.local = triangleFrame(a, bb, c).transpose() * (x - q);
+    const Vec3 a = pos(t[0]), bb = pos(t[1]), c = pos(t[2]);
+    const Vec3 nf = unitFaceNormal(a, bb, c);
+    // x = y(w) + h·n_s(w) with y on the triangle's plane: a fixed point in w, from the closest
+    // point's weights (it contracts by about h/R, R the surface's radius of curvature there).
+    const double scale = std::max({1.0, x.norm(), (bb - a).norm(), (c - a).norm()});
+    for (int it = 0; it < 20; ++it) {
+        const Vec3 ns = smoothNormal(mesh, b.triangle, b.w, pos);
+        const double cosine = ns.dot(nf);
+        if (!(cosine > 0.2)) break;
+        b.height = (x - a).dot(nf) / cosine;
+        planeWeights(x - b.height * ns, a, bb, c, b.w);
+        if ((bound(mesh, b, pos) - x).norm() <= 1e-12 * scale) return b;
+    }
+    if ((bound(mesh, b, pos) - x).norm() <= 1e-9 * scale && b.height == b.height) return b;
+    // Along the face normal: exact by construction.
+    b.alongFace = true;
+    b.height = (x - a).dot(nf);
+    planeWeights(x - b.height * nf, a, bb, c, b.w);
     return b;
 }
 
 Vec3 boundPosition(const MeshSequence& mesh, const SurfaceBinding& b, double t) {
-    const auto& tri = mesh.triangles()[b.triangle];
-    const Vec3 a = mesh.vertexAt(tri[0], t), bb = mesh.vertexAt(tri[1], t), c = mesh.vertexAt(tri[2], t);
-    return b.w[0] * a + b.w[1] * bb + b.w[2] * c + triangleFrame(a, bb, c) * b.local;
+    return bound(mesh, b, [&](int v) { return mesh.vertexAt(v, t); });
 }
 
 } // namespace gale::solver

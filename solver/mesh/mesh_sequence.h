@@ -56,6 +56,15 @@ public:
     const std::vector<double>& firstPositions() const { return mFrames->front(); }
     // One vertex at time t (the same interpolation as positionsAt).
     Vec3 vertexAt(int v, double t) const;
+    // The triangles around vertex v (indices into triangles()) and v's corner in each (0–2).
+    struct Corner {
+        int triangle, corner;
+    };
+    const Corner* cornersBegin(int v) const { return mCorners.data() + mCornerStart[v]; }
+    const Corner* cornersEnd(int v) const { return mCorners.data() + mCornerStart[v + 1]; }
+    // The angle-weighted normal of vertex v at time t (Thürmer & Wüthrich 1998: each incident
+    // face's unit normal times the corner's angle; unit length, zero on a vertex without area).
+    Vec3 vertexNormalAt(int v, double t) const;
 
 private:
     // The pre-roll (eased()): x(t) = rest + h(u)·dp + g(u)·dv for t < to.
@@ -67,7 +76,11 @@ private:
     void rawPositionsAt(double t, std::vector<double>& out) const;
     Vec3 rawVertexAt(int v, double t) const;
 
+    void buildCorners();
+
     std::vector<std::array<int, 3>> mTriangles;
+    std::vector<Corner> mCorners; // per vertex, its triangles (CSR over mCornerStart)
+    std::vector<size_t> mCornerStart;
     std::shared_ptr<const std::vector<std::vector<double>>> mFrames;
     std::shared_ptr<const Ease> mEase;
     long mFirstFrame = 0;
@@ -76,15 +89,22 @@ private:
     std::string mPath;
 };
 
-// A point bound to a mesh's surface (attachments): its closest triangle at the first frame,
-// the barycentric weights of the closest point q there, and the point's offset from q in the
-// triangle's frame (ê₁ along the first edge, n̂ the face normal, n̂ × ê₁), so that it follows
-// the triangle rigidly — exactly its own position at the bind frame, and q + offset·n̂ when it
-// lies over the face's interior.
+// A point bound to a mesh's surface (attachments) so that it rides the skin smoothly: its
+// closest triangle at the bind pose, the point y on that triangle's plane it projects to along the
+// smoothed normal n_s (barycentric weights w, which may leave the triangle), and its height h
+// along n_s: x = Σ wₖ pₖ + h·n_s, with n_s(w) = normalize(Σ ŵₖ Nₖ), Nₖ the angle-weighted vertex
+// normals and ŵ the weights clamped to the triangle (Maya's "attract to matching mesh" and
+// Houdini's "attach to geometry" ride a smooth frame the same way). Exactly the point's own
+// position at the bind pose; a continuous function of the point across the triangles' edges (two
+// neighbours bound to two triangles stay together as the skin bends), where a rigid offset in each
+// triangle's own frame jumps at every crease. `alongFace`: n_s would not reach the point (vertex
+// normals near the face's plane, or a point far above a curved surface), so the height is along
+// the face normal instead.
 struct SurfaceBinding {
     int triangle = -1;
     double w[3] = {0, 0, 0};
-    Vec3 local = Vec3::Zero();
+    double height = 0.0;
+    bool alongFace = false;
 };
 // `t` (s): the time of the pose it binds against, the body interpolated there (NaN: the
 // sequence's first file).
