@@ -254,7 +254,7 @@ bool Loader::pins(const toml::node& n, const std::string& what, PinSpec& out, bo
         return false;
     }
     if (attachKeys)
-        checkKeys(*t, {"mesh", "vertices", "map", "box"}, what);
+        checkKeys(*t, {"mesh", "vertices", "map", "box", "stiffness"}, what);
     else
         checkKeys(*t, {"vertices", "map", "box", "translate", "rotate"}, what);
     bool ok = true;
@@ -353,7 +353,13 @@ bool Loader::attach(const toml::node& n, const std::string& what, const std::str
     } else {
         ok = false;
     }
+    // stiffness (N/m per vertex): a soft attachment, a zero-length spring to the bound point.
+    if (const toml::node* k = t->get("stiffness"))
+        ok = number(*k, what + ": stiffness (N/m per vertex; leave it out for a hard attachment)",
+                    out.stiffness, 0.0, true) &&
+             ok;
     if (!t->get("vertices") && !t->get("map") && !t->get("box")) {
+        checkKeys(*t, {"mesh", "vertices", "map", "box", "stiffness"}, what);
         if (needSelection) {
             error(n, what + " needs vertices = [...], map = \"property\" or box = [x0, y0, z0, x1, y1, z1]");
             ok = false;

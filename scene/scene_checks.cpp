@@ -15,6 +15,9 @@ using solver::Vec3;
 
 namespace {
 
+// How far the body may stretch or compress an attached edge before runWarnings says so.
+constexpr double kBindingLimit = 0.10;
+
 struct Box {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
     Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
@@ -90,6 +93,58 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         bodyBoxes.push_back(boxOf(x));
         cloth.add(bodyBoxes.back());
         clothExtent = std::max(clothExtent, bodyBoxes.back().extent());
+    }
+    // Attached edges (both ends bound to a body's surface) that the body's motion stretches or
+    // compresses past kBindingLimit over the run's frames: the cloth there cannot do better than
+    // the skin (hard) or fights it (soft).
+    std::vector<std::pair<int, solver::Vec3>> bound;
+    for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
+        const ClothSpec& spec = scene.cloths[i];
+        const solver::Body& body = *bodies[i];
+        body.attachmentTargets(s.frameTime(first), bound);
+        if (!spec.hasAttach || bound.empty()) continue;
+        std::vector<int> slot(body.vertexCount(), -1);
+        for (size_t k = 0; k < bound.size(); ++k) slot[bound[k].first] = static_cast<int>(k);
+        std::vector<std::array<int, 3>> attached; // edge's two slots and its index
+        for (size_t e = 0; e < body.edges().size(); ++e) {
+            const auto& ed = body.edges()[e];
+            if (slot[ed[0]] >= 0 && slot[ed[1]] >= 0)
+                attached.push_back({slot[ed[0]], slot[ed[1]], static_cast<int>(e)});
+        }
+        if (attached.empty()) continue;
+        const auto& x0 = body.positions();
+        double worst = 1.0;
+        int worstFrame = first, worstEdge = -1;
+        size_t past = 0;
+        for (int f = first; f <= last; ++f) {
+            body.attachmentTargets(s.frameTime(f), bound);
+            for (const auto& a : attached) {
+                const auto& ed = body.edges()[a[2]];
+                const double len0 = (x0.segment<3>(3 * ed[0]) - x0.segment<3>(3 * ed[1])).norm();
+                if (!(len0 > 0.0)) continue;
+                const double r = (bound[a[0]].second - bound[a[1]].second).norm() / len0;
+                const bool out = r > 1.0 + kBindingLimit || r < 1.0 - kBindingLimit;
+                if (out) ++past;
+                if (std::fabs(std::log(r)) > std::fabs(std::log(worst))) {
+                    worst = r;
+                    worstFrame = f;
+                    worstEdge = a[2];
+                }
+            }
+        }
+        if (!past) continue;
+        const auto& ed = body.edges()[worstEdge];
+        SceneError e = sceneErrorAt(
+            scene.wind.path, spec.attach.line, spec.attach.col,
+            "[[cloth]] '" + spec.name + "' attach: the body's motion " +
+                (worst > 1.0 ? "stretches" : "compresses") + " the attached edges to " +
+                metres(worst) + "x their length (edge " + std::to_string(ed[0]) + "-" +
+                std::to_string(ed[1]) + " at frame " + std::to_string(worstFrame) + "; " +
+                std::to_string(past) + " edge-frames past +/-" + metres(100.0 * kBindingLimit) +
+                " %): the cloth there follows the skin (hard) or fights it (stiffness); bind "
+                "closer to the surface, where the body deforms less, or soften it with stiffness");
+        e.warning = true;
+        out.push_back(std::move(e));
     }
     for (const solver::Collider& c : scene.colliders) {
         const std::string what = "[[collider]] '" + c.name + "'";

@@ -406,6 +406,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             std::string problem;
             att.attach = attachSequence(scene, spec.attachMesh, problem);
             att.bindTime = bindTime;
+            att.stiffness = spec.attach.stiffness;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));
@@ -476,6 +477,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             std::string problem;
             att.attach = attachSequence(scene, spec.attachMesh, problem);
             att.bindTime = bindTime;
+            att.stiffness = spec.attach.stiffness;
             if (!att.attach) {
                 errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
                                             what + " attach: " + problem));

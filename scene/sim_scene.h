@@ -38,6 +38,7 @@ struct PinSpec {
     double box[6] = {0, 0, 0, 0, 0, 0};
     fields::Param translate{std::vector<double>{0.0, 0.0, 0.0}};
     solver::PinRotation rotate;
+    double stiffness = 0.0; // attach: N/m per vertex, a soft attachment (0: hard)
     int line = 0, col = 0;
 };
 

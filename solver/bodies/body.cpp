@@ -89,9 +89,16 @@ void Body::finishSetup(const std::vector<std::array<int, 2>>& edges) {
 void Body::addPins(const PinSet& pins) {
     const int set = static_cast<int>(mPinSets.size());
     mPinSets.push_back(pins);
+    const bool soft = pins.attach && !pins.attach->triangles().empty() && pins.stiffness > 0.0;
     for (int v : pins.vertices) {
         if (v < 0 || static_cast<size_t>(v) >= vertexCount()) continue;
         if (std::find(mPinned.begin(), mPinned.end(), v) != mPinned.end()) continue;
+        if (soft) {
+            mSoft.push_back({v, set,
+                             std::make_shared<const SurfaceBinding>(bindToSurface(
+                                 *pins.attach, vec3At(mX.data(), v), pins.bindTime))});
+            continue;
+        }
         mPinned.push_back(v);
         mPinSet.push_back(set);
         mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
@@ -173,7 +180,30 @@ double Body::elasticEnergy(double t) {
     ForceOutput out;
     out.f = &f;
     addForces(in, out);
+    addSoftAttachments(in, out, false);
     return out.elasticEnergy;
+}
+
+void Body::attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const {
+    out.clear();
+    for (size_t k = 0; k < mPinned.size(); ++k)
+        if (mPinBinding[k]) out.emplace_back(mPinned[k], pinTarget(k, t));
+    for (const SoftAttachment& s : mSoft)
+        out.emplace_back(s.vertex, boundPosition(*mPinSets[s.set].attach, *s.binding, t));
+}
+
+void Body::addSoftAttachments(const ForceInput& in, ForceOutput& out, bool matrix) const {
+    const double h = in.h, t = in.t + in.h;
+    for (const SoftAttachment& s : mSoft) {
+        const PinSet& set = mPinSets[s.set];
+        const double k = set.stiffness;
+        const Vec3 d = vec3At(in.x, s.vertex) - boundPosition(*set.attach, *s.binding, t);
+        out.f->segment<3>(3 * s.vertex) -= k * d;
+        out.elasticEnergy += 0.5 * k * d.squaredNorm();
+        if (!matrix) continue;
+        if (out.kv) out.kv->segment<3>(3 * s.vertex) += k * vec3At(in.v, s.vertex);
+        if (out.A) out.A->addDiagonal(out.A->diagonalSlot(s.vertex), h * h * k);
+    }
 }
 
 double Body::maxEdgeStretch() const {
@@ -214,6 +244,7 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     out.skewed = false;
     if (matrix) mAero.clear();
     addForces(in, out);
+    addSoftAttachments(in, out, matrix);
     if (matrix) {
         mSkewed = out.skewed;
         mAeroPosition = in.aeroPosition && !mAero.empty();
@@ -740,6 +771,7 @@ double Body::elasticAt(const VecX& x, double t, VecX& fEl) {
     ForceOutput out;
     out.f = &fEl;
     addForces(in, out);
+    addSoftAttachments(in, out, false);
     return out.elasticEnergy;
 }
 

@@ -55,6 +55,10 @@ struct PinSet {
     // s: the time of the body's pose the attachment binds against — the first simulated frame's
     // (the start state's) time; NaN: the sequence's first file.
     double bindTime = NAN;
+    // N/m per vertex: a soft attachment, each vertex pulled to its bound point p(t) by a
+    // zero-length spring, f = −k (x − p(t + h)) at the step's end (backward Euler, its stiffness in
+    // the implicit matrix: A += h² k I), energy ½ k |x − p|². 0: hard (a pin on the surface).
+    double stiffness = 0.0;
 };
 
 // Numerical settings of a body's substep.
@@ -257,6 +261,8 @@ public:
     const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
     // Edge e's length at positions x over its rest length (0 for an edge of zero rest length).
     double edgeStretchOf(const VecX& x, size_t e) const;
+    // Every vertex bound to a body's surface (hard and soft attachments) and its bound point at t.
+    void attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const;
     // Whether pin k (pinnedVertices()[k]) follows an attachment (a body's surface), not a pin.
     bool pinIsAttachment(size_t k) const { return k < mPinBinding.size() && mPinBinding[k]; }
 
@@ -319,6 +325,16 @@ private:
     std::vector<std::shared_ptr<const SurfaceBinding>>
         mPinBinding;            // per pin: its attachment, or null
     VecX mAnchor;               // 3 per pin: initial position
+    // Soft attachments (PinSet::stiffness > 0): free vertices pulled to their bound points.
+    struct SoftAttachment {
+        int vertex;
+        int set; // into mPinSets
+        std::shared_ptr<const SurfaceBinding> binding;
+    };
+    std::vector<SoftAttachment> mSoft;
+    // Adds the soft attachments' springs to forces, K v, A and the elastic energy, targets at
+    // in.t + in.h (after addForces, wherever it is called).
+    void addSoftAttachments(const ForceInput& in, ForceOutput& out, bool matrix) const;
     std::vector<uint8_t> mHeld; // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mEdgeRest;
