@@ -43,9 +43,9 @@ const std::vector<std::string> kClothKeys =
     withStepKeys({"name", "mesh", "grid", "density", "stretch", "shear", "bend", "damping", "lift",
                   "drag", "aero_model", "aero_jacobian", "rest_shape", "rest_mesh", "attach",
                   "self_collision", "thickness"});
-const std::vector<std::string> kHairKeys =
-    withStepKeys({"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping",
-                  "drag_normal", "drag_tangent", "root_pinned", "rest_shape", "attach"});
+const std::vector<std::string> kHairKeys = withStepKeys(
+    {"name", "strands", "grid", "radius", "density", "stretch", "bend", "damping", "drag_normal",
+     "drag_tangent", "root_pinned", "rest_shape", "attach", "collide_cloth"});
 const std::vector<std::string> kColliderKeys = {
     "name", "type",      "center",   "radius", "point", "normal",   "a",
     "b",    "thickness", "friction", "mesh",   "voxel", "rest_mesh"};
@@ -583,6 +583,8 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
     }
     if (const toml::node* n = t.get("attach"))
         h.hasAttach = attach(*n, what + " attach", baseDir, false, h.attach, h.attachMesh);
+    if (const toml::node* n = t.get("collide_cloth"))
+        boolean(*n, what + ": collide_cloth", h.collideCloth);
     if (const toml::node* n = t.get("pins"))
         error(*n, what + ": strands are pinned at their roots (root_pinned = true); pins maps are for cloth");
     stepOptions(t, what, h.step, h.output);

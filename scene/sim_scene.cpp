@@ -506,6 +506,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             if (!rest.vertices.empty()) hair->addPins(rest);
         }
         hair->options() = spec.step;
+        hair->collision().self = spec.collideCloth;
         hair->limits().overStretch = scene.solver.overStretch;
         hair->limits().velocityJump = scene.solver.velocityJump;
         bodies.push_back(std::move(hair));

@@ -86,6 +86,9 @@ struct HairSpec {
     bool hasAttach = false;
     PinSpec attach;
     std::string attachMesh; // resolved
+    // collide_cloth: the strands' segments against the scene's colliding cloth (the cloth with
+    // self_collision = true), continuous, in the cloth's collision pass.
+    bool collideCloth = true;
     solver::StepOptions step;
     std::string output = "obj";
     int line = 0, col = 0;

@@ -109,6 +109,7 @@ void SelfCollision::addBody(Body& body, const std::vector<std::array<int, 3>>& t
         mTris.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
         mTriBody.push_back(b);
     }
+    mBodyHasTriangles.push_back(!triangles.empty());
     for (const auto& e : body.edges()) mEdges.push_back({e[0] + offset, e[1] + offset});
     // Vertex neighbours by edges, CSR with sorted rows (neighbours()).
     std::vector<std::vector<int>> rows(mVertexBody.size());
@@ -229,6 +230,10 @@ void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>
                 const auto& eb = mEdges[f];
                 if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
                 if (held(ea[0], ea[1], eb[0], eb[1])) return;
+                // Strand against strand (hair has no triangles): not modelled.
+                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
+                    !mBodyHasTriangles[mVertexBody[eb[0]]])
+                    return;
                 eeOut.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
             });
         });

@@ -48,6 +48,8 @@ public:
 
     // A colliding body: its triangles (vertex indices of the body), rest positions (3 per
     // vertex: pairs closer than the thickness at rest are never repelled), thickness ξ (m).
+    // A body without triangles (hair: its edges, the strands' segments) collides with the
+    // others' triangles (vertex–triangle) and edges (edge–edge), never with another strand.
     void addBody(Body& body, const std::vector<std::array<int, 3>>& triangles,
                  const VecX& restPositions, double thickness);
     size_t bodyCount() const { return mBodies.size(); }
@@ -108,6 +110,7 @@ private:
     std::vector<int> mVertexBody;
     std::vector<std::array<int, 3>> mTris; // global vertices
     std::vector<int> mTriBody;
+    std::vector<uint8_t> mBodyHasTriangles; // per body
     std::vector<std::array<int, 2>> mEdges;
     std::vector<int> mAdjacencyStart, mAdjacency; // vertex neighbours by edges (CSR)
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;

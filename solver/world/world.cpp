@@ -74,6 +74,15 @@ void World::setUpSelfCollision(FrameStats& fs) {
         mSelfBodies.push_back(b);
     }
     if (mSelfBodies.empty()) return;
+    // Hair that collides with cloth (collision().self on a body without triangles) joins the
+    // pass when some cloth is in it: its segments against the cloth's triangles and edges.
+    static const std::vector<std::array<int, 3>> kNone;
+    for (size_t b = 0; b < mBodies.size(); ++b) {
+        Body& body = *mBodies[b];
+        if (!body.collision().self || body.collisionTriangles()) continue;
+        self->addBody(body, kNone, body.restPositions(), body.collision().thickness);
+        mSelfBodies.push_back(b);
+    }
     mSelf = std::move(self);
     // A start that already intersects cannot be untangled; the passes keep it from worsening.
     const std::vector<int> start = mSelf->intersectionsPerBody();
