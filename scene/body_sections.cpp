@@ -643,9 +643,13 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
     if (type != "mesh" || !mesh || !string(*mesh, what + ": mesh", file)) return;
     if (const toml::node* n = t.get("voxel"))
         if (!number(*n, what + ": voxel (m)", voxel, 0.0, true)) return;
-    const std::filesystem::path p(file);
-    const std::string path = p.is_absolute() ? file
-                             : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
+    // A file named in the collider: relative to the scene's folder.
+    const auto sceneFile = [&](const std::string& name) {
+        const std::filesystem::path p(name);
+        return p.is_absolute() ? name
+                               : (std::filesystem::path(mPath).parent_path() / p).lexically_normal().string();
+    };
+    const std::string path = sceneFile(file);
     std::string problem;
     if (io::hasFrameToken(path)) {
         // A per-frame sequence ('#' run, %04d or $F4): triangles, a refitted tree and continuous contact
@@ -659,13 +663,8 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
             // The rest (bind) pose the pre-roll eases the body from (scene.preroll).
             std::string restFile;
             if (!string(*r, what + ": rest_mesh", restFile)) return;
-            const std::filesystem::path rp(restFile);
-            const std::string restPath =
-                rp.is_absolute()
-                    ? restFile
-                    : (std::filesystem::path(mPath).parent_path() / rp).lexically_normal().string();
             TriMesh m;
-            if (!loadMesh(restPath, m, problem)) {
+            if (!loadMesh(sceneFile(restFile), m, problem)) {
                 error(*r, what + ": rest_mesh: " + problem);
                 return;
             }

@@ -101,8 +101,9 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
         const ClothSpec& spec = scene.cloths[i];
         const solver::Body& body = *bodies[i];
+        if (!spec.hasAttach) continue;
         body.attachmentTargets(s.frameTime(first), bound);
-        if (!spec.hasAttach || bound.empty()) continue;
+        if (bound.empty()) continue;
         std::vector<int> slot(body.vertexCount(), -1);
         for (size_t k = 0; k < bound.size(); ++k) slot[bound[k].first] = static_cast<int>(k);
         std::vector<std::array<int, 3>> attached; // edge's two slots and its index

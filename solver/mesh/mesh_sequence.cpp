@@ -269,10 +269,6 @@ Vec3 bound(const MeshSequence& m, const SurfaceBinding& b, const Pos& pos) {
 
 } // namespace
 
-Vec3 MeshSequence::vertexNormalAt(int v, double t) const {
-    return angleWeightedNormal(*this, v, [&](int k) { return vertexAt(k, t); });
-}
-
 SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double when) {
     SurfaceBinding b;
     double best = INFINITY;

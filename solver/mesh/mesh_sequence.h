@@ -36,7 +36,6 @@ public:
     // `rest` has another vertex count or from ≥ to.
     std::shared_ptr<const MeshSequence> eased(std::vector<double> rest, double from, double to,
                                               std::string& error) const;
-    bool isEased() const { return static_cast<bool>(mEase); }
 
     size_t vertexCount() const { return mFrames->empty() ? 0 : mFrames->front().size() / 3; }
     const std::vector<std::array<int, 3>>& triangles() const { return mTriangles; }
@@ -62,9 +61,6 @@ public:
     };
     const Corner* cornersBegin(int v) const { return mCorners.data() + mCornerStart[v]; }
     const Corner* cornersEnd(int v) const { return mCorners.data() + mCornerStart[v + 1]; }
-    // The angle-weighted normal of vertex v at time t (Thürmer & Wüthrich 1998: each incident
-    // face's unit normal times the corner's angle; unit length, zero on a vertex without area).
-    Vec3 vertexNormalAt(int v, double t) const;
 
 private:
     // The pre-roll (eased()): x(t) = rest + h(u)·dp + g(u)·dv for t < to.
