@@ -76,7 +76,10 @@ report: build
 ASAN_BUILD ?= build-asan
 # ccache only when installed (CI machines start without it).
 SAN_LAUNCHER := $(if $(shell command -v ccache 2>/dev/null),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-SAN_CMAKE  := -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALE_BUILD_BENCH=OFF $(SAN_LAUNCHER)
+# -O1 -g1 (line tables only: reports still name file and line): the sanitizer build compiles
+# 3-5x faster than at -O2 -g, which is most of CI's time, and runs the tests about as fast.
+SAN_FLAGS  := -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
+SAN_CMAKE  := -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $(SAN_FLAGS) -DGALE_BUILD_BENCH=OFF $(SAN_LAUNCHER)
 SAN_SUPP   := $(CURDIR)/tests/sanitizers
 # san_check DIR: prints every report under DIR and fails when there is one.
 san_check = if [ -n "$$(ls -A $(1) 2>/dev/null)" ]; then cat $(1)/*; \
@@ -124,7 +127,7 @@ fuzz: deps
 		if [ "$$(id -u)" != 0 ]; then echo "gale: run as root (or install them yourself)"; exit 1; fi; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
-	CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGALE_FUZZ=ON \
+	CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $(SAN_FLAGS) -DGALE_FUZZ=ON \
 		-DGALE_SANITIZE=address,undefined -DGALE_BUILD_TESTS=OFF -DGALE_BUILD_BENCH=OFF $(FUZZ_LAUNCHER)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(FUZZ_HARNESSES)
 	fuzz/seed.sh $(FUZZ_BUILD)/corpus

@@ -355,7 +355,7 @@ TEST_CASE("multigrid: smoothed aggregation with rotations agrees with LDLT on ir
 }
 
 TEST_CASE("multigrid: smoothed-aggregation iterations stay bounded from 32x32 to 256x256",
-          "[multigrid][scaling]") {
+          "[multigrid][scaling][heavy]") {
     // The count at 256² against 32² (8× the resolution, 64× the vertices) at frame-size and
     // substep-size steps, regular and irregular: smoothed aggregation with rotations stays
     // within 1.6× (measured 6→9 at worst); plain aggregation on the same systems grows over 2.5×
