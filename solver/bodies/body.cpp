@@ -1094,16 +1094,22 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     landed();
 
     // 6. Colliders: moving meshes first swept continuously over the step (no vertex or edge
-    // crosses the surface, moving_collider.h), then push out, approach speed, Coulomb friction.
-    if (env.colliders)
+    // crosses the surface, no body vertex crosses a cloth triangle: moving_collider.h), then
+    // push out, approach speed, Coulomb friction. Hair has no triangles (its segments meet the
+    // body's edges).
+    if (env.colliders) {
+        static const std::vector<std::array<int, 3>> noTriangles;
+        const std::vector<std::array<int, 3>>* tris = collisionTriangles();
         for (const Collider& c : *env.colliders)
             if (c.moving) {
                 std::vector<uint8_t> movable(n);
                 for (size_t i = 0; i < n; ++i)
                     movable[i] = mConstraints.kind[i] != 1 || mContactCollider[i] >= 0;
                 st.projected += c.moving->sweep(x0, mX, mV, movable, mEdges,
-                                                colliderThickness(c), c.friction, h);
+                                                tris ? *tris : noTriangles, colliderThickness(c),
+                                                c.friction, h);
             }
+    }
     st.contacts = resolveContacts(env, h, st);
 
     // 7. Trouble detection.
