@@ -184,6 +184,35 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     return true;
 }
 
+bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& c, double radius,
+                                      Vec3& p, double w[3], double& distance,
+                                      Vec3& velocity) const {
+    if (!mBuilt) return false;
+    contact::Box q;
+    q.add(a);
+    q.add(b);
+    q.add(c);
+    q.inflate(radius);
+    double best = radius * radius;
+    int bestVertex = -1;
+    mVertexBvh.queryEach(q, [&](int k) {
+        const int v = mVertices[k];
+        double wk[3];
+        const double d2 = contact::pointTriangleDistance2(corner(false, v), a, b, c, wk);
+        if (d2 < best || (d2 == best && bestVertex >= 0 && v < bestVertex)) {
+            best = d2;
+            bestVertex = v;
+            std::copy(wk, wk + 3, w);
+        }
+    });
+    if (bestVertex < 0) return false;
+    p = corner(false, bestVertex);
+    distance = std::sqrt(best);
+    const double h = mT1 - mT0;
+    velocity = h > 0.0 ? Vec3((corner(true, bestVertex) - p) / h) : Vec3::Zero();
+    return true;
+}
+
 int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
                              const std::vector<std::array<int, 2>>& edges,

@@ -1,9 +1,10 @@
 // Moving and deforming mesh colliders (a MeshSequence): per substep the triangles' corners at
 // both ends of the step, their swept boxes refitted into one AABB tree (built once), closest-point
 // queries at the ends (the in-solve constraints and the thickness push-out, with the surface
-// velocity of the motion), and the continuous pass that keeps cloth from crossing the surface
-// during the step: cloth vertex–body triangle, edge–edge and body vertex–cloth triangle CCD
-// (solver/contact/ccd.h) with a thickness.
+// velocity of the motion), the body vertex nearest a cloth triangle (the in-solve side of the
+// body vertex–cloth triangle pair, Body::contactConstraints), and the continuous pass that keeps
+// cloth from crossing the surface during the step: cloth vertex–body triangle, edge–edge and
+// body vertex–cloth triangle CCD (solver/contact/ccd.h) with a thickness.
 #pragma once
 
 #include "solver/contact/bvh.h"
@@ -43,6 +44,13 @@ public:
     // the surface towards x (the face normal when x is on it), and the surface velocity there
     // (the mean over the step, m/s). Returns false when nothing is within radius.
     bool closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const;
+
+    // The body vertex nearest to triangle (a, b, c) at the start of the prepared step, searched
+    // within `radius` (m): its position p, the weights w of the triangle's point closest to it,
+    // their distance (m) and the vertex's velocity over the step (m/s). False when none is
+    // within radius. (The in-solve side of the body vertex–cloth triangle pair.)
+    bool nearestVertex(const Vec3& a, const Vec3& b, const Vec3& c, double radius, Vec3& p,
+                       double w[3], double& distance, Vec3& velocity) const;
 
     // The continuous pass over the prepared step for one body: vertex i moves from x0 to x1
     // (where `movable[i]`), edges and triangles as given (`triangles` empty for hair). Where a

@@ -330,9 +330,10 @@ TEST_CASE("moving mesh: a 1 cm rod at 2 m/s does not pass through a sheet of 2.5
             // past where the sheet hung.
             CHECK(o.tip > 0.04);
             CHECK(o.pushed > o.tip);
-            // Not torn: no edge past 4× its rest length. The pair acts after the solve, which
-            // does not see it, so the apex of the tent stays sharper than the cloth's own
-            // response would make it (measured 2.3–3.1×; docs/solver.md, "Where it is weaker").
-            CHECK(o.maxStretch < 4.0);
+            // Not torn: no edge past the solver's own over-stretch limit (BodyLimits, 3×). The
+            // in-solve contact planes of the pair carry the tent (measured 1.14–1.25, and 2.63
+            // at one substep tilted, at the first impact, which only the continuous pass sees;
+            // with the pass alone, 2.4–3.1).
+            CHECK(o.maxStretch < 3.0);
         }
 }

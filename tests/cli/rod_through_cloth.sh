@@ -5,8 +5,8 @@
 # no cloth vertex meets the rod's triangles and no cloth edge its edges, only its tip vertex
 # meets the face. Counted from the output files, independently of gale
 # (count_intersections.py --pairs): no rod triangle intersects a sheet triangle in any frame, no
-# frame failed, and the largest edge stretch (run.json) stays below 4 (the tent's apex:
-# docs/solver.md). Before the pair existed the rod went through (144 intersecting pairs at 1 and 2
+# frame failed, and the largest edge stretch (run.json) stays below the solver's over-stretch
+# limit, 3 (measured 1.14). Before the pair existed the rod went through (144 intersecting pairs at 1 and 2
 # substeps); without the [[collider]] it does too (so the count can fail).
 source "$(dirname "$0")/lib.bash" "$@"
 PY=$(test -x /usr/bin/python3 && echo /usr/bin/python3 || echo python3)
@@ -89,7 +89,7 @@ for sub in 1 2; do
     s=$(stretch on$sub)
     echo "substeps $sub: $n crossing pairs, largest stretch $s" >&2
     expect_eq "$n" "0" "no rod triangle crosses a sheet triangle ($sub substeps)"
-    awk -v s="$s" 'BEGIN { exit !(s + 0 > 0 && s + 0 < 4.0) }' ||
+    awk -v s="$s" 'BEGIN { exit !(s + 0 > 0 && s + 0 < 3.0) }' ||
         fail "the sheet is pushed, not torn ($sub substeps): largest stretch $s"
 done
 
