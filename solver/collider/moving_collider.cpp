@@ -8,6 +8,16 @@
 // v_s = Σ w_k (p_k(t₁) − p_k(t₀))/h the surface velocity: contact and friction in the moving
 // frame of the body. Each pass re-checks the moved trajectories x₀ → x₁; a vertex still hitting
 // after the last pass is left at its last projection (counted as unresolved).
+// The third pair, a body vertex p (kinematic: infinite mass) against a cloth triangle
+// (x_a, x_b, x_c) with weights w at the closest point met, n₁ the cloth's face normal at t₁ on
+// the side of p (the direction from the cloth point to p off the face's interior): the cloth
+// point c = Σ w_k x_k must end at least ξ from p along n₁, so with the shortfall
+// s = ξ − (p(t₁) − c(t₁))·n₁ > 0 each movable corner moves by
+//   Δx_k = −(w_k / Σ_j w_j²) s n₁     (pinned corners: w_k = 0 in both places),
+// the inelastic impulse of a point against a triangle (Bridson, Fedkiw & Anderson 2002, §7.2)
+// with the point's mass infinite: Σ w_k Δx_k = −s n₁, the interpolated point moves exactly s.
+// The velocity change Δu of the interpolated point (u = Σ w_k v_k − ṗ, the same approach and
+// friction rule as above along −n₁) is split the same way, Δv_k = (w_k / Σ w_j²) Δu.
 #include "solver/collider/moving_collider.h"
 
 #include "solver/collider/collider.h"
@@ -62,6 +72,12 @@ double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi
 MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
     : mMesh(std::move(mesh)) {
     mEdges = meshEdges(mMesh->triangles());
+    std::vector<uint8_t> used(mMesh->vertexCount(), 0);
+    for (const auto& t : mMesh->triangles())
+        for (int v : t)
+            if (v >= 0 && static_cast<size_t>(v) < used.size()) used[v] = 1;
+    for (size_t v = 0; v < used.size(); ++v)
+        if (used[v]) mVertices.push_back(static_cast<int>(v));
 }
 
 Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
@@ -105,13 +121,19 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
     // three times, to be sorted and made unique).
     mEdgeBoxes.resize(mEdges.size());
     for (size_t e = 0; e < mEdges.size(); ++e) mEdgeBoxes[e] = sweptBox(mEdges[e].data(), 2);
+    // And the body's vertices, for the body vertex–cloth triangle pair (queried with each cloth
+    // triangle's swept box).
+    mVertexBoxes.resize(mVertices.size());
+    for (size_t v = 0; v < mVertices.size(); ++v) mVertexBoxes[v] = sweptBox(&mVertices[v], 1);
     if (!mBuilt) {
         mBvh.build(mBoxes);
         mEdgeBvh.build(mEdgeBoxes);
+        mVertexBvh.build(mVertexBoxes);
         mBuilt = true;
     } else {
         mBvh.refit(mBoxes);
         mEdgeBvh.refit(mEdgeBoxes);
+        mVertexBvh.refit(mVertexBoxes);
     }
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
@@ -162,9 +184,39 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     return true;
 }
 
+bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& c, double radius,
+                                      Vec3& p, double w[3], double& distance,
+                                      Vec3& velocity) const {
+    if (!mBuilt) return false;
+    contact::Box q;
+    q.add(a);
+    q.add(b);
+    q.add(c);
+    q.inflate(radius);
+    double best = radius * radius;
+    int bestVertex = -1;
+    mVertexBvh.queryEach(q, [&](int k) {
+        const int v = mVertices[k];
+        double wk[3];
+        const double d2 = contact::pointTriangleDistance2(corner(false, v), a, b, c, wk);
+        if (d2 < best || (d2 == best && bestVertex >= 0 && v < bestVertex)) {
+            best = d2;
+            bestVertex = v;
+            std::copy(wk, wk + 3, w);
+        }
+    });
+    if (bestVertex < 0) return false;
+    p = corner(false, bestVertex);
+    distance = std::sqrt(best);
+    const double h = mT1 - mT0;
+    velocity = h > 0.0 ? Vec3((corner(true, bestVertex) - p) / h) : Vec3::Zero();
+    return true;
+}
+
 int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
-                             const std::vector<std::array<int, 2>>& edges, double thickness,
+                             const std::vector<std::array<int, 2>>& edges,
+                             const std::vector<std::array<int, 3>>& triangles, double thickness,
                              double friction, double h, int passes) {
     if (!mBuilt) return 0;
     const size_t n = x0.size() / 3;
@@ -180,6 +232,9 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     opt.shrinkWithinThickness = true;
     std::vector<int> cand;
     std::vector<uint8_t> moved(n, 0);
+    // Cloth triangles hit by a body vertex that no movable corner can carry (all pinned, or the
+    // point met on a pinned corner): counted unresolved once and left alone.
+    std::vector<uint8_t> stuck(triangles.size(), 0);
     int movedCount = 0;
     // The velocity response at vertex i against a surface point moving at vs, normal n1.
     auto respond = [&](int i, const Vec3& vs, const Vec3& n1) {
@@ -198,6 +253,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             ++movedCount;
         }
     };
+    const double want = thickness * (1.0 + 1e-6) + 1e-9; // the distance a hit is placed at
     auto surfaceVelocity = [&](int tri, const double w[3]) {
         Vec3 vs = Vec3::Zero();
         if (h > 0.0)
@@ -330,7 +386,6 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 Eigen::Map<Vec3> xa(x1.data() + 3 * i), xb(x1.data() + 3 * j);
                 const Vec3 cloth1 = xa + sa * (xb - xa);
                 const double gap = (cloth1 - body1).dot(nn);
-                const double want = thickness * (1.0 + 1e-6) + 1e-9;
                 if (gap < want) {
                     // Move the cloth point by (want − gap) n: the edge's vertices by their
                     // weights, scaled so the interpolated point moves exactly that far.
@@ -351,6 +406,123 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 ++mStats.edgeHits;
             }
             mStats.narrowSeconds += seconds(tn);
+        }
+        // Body vertices against cloth triangles: a body part thinner than the cloth's edges (a
+        // finger, a rod) can pass through a face with no cloth vertex inside it and no edge
+        // crossing an edge; only its vertices meet the face.
+        for (size_t f = 0; f < triangles.size(); ++f) {
+            if (stuck[f]) continue;
+            const int* tv = triangles[f].data();
+            Vec3 c0[3], c1[3];
+            bool finite = true;
+            for (int k = 0; k < 3; ++k) {
+                c0[k] = vec3At(x0.data(), tv[k]);
+                c1[k] = vec3At(x1.data(), tv[k]);
+                finite = finite && c0[k].allFinite() && c1[k].allFinite();
+            }
+            if (!finite) continue; // left to the trouble detector
+            auto tb = std::chrono::steady_clock::now();
+            contact::Box q;
+            for (int k = 0; k < 3; ++k) {
+                q.add(c0[k]);
+                q.add(c1[k]);
+            }
+            q.inflate(thickness);
+            cand.clear();
+            mVertexBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            std::sort(cand.begin(), cand.end()); // body vertex order: a fixed tie-break
+            const double broad = seconds(tb);
+            mStats.broadSeconds += broad;
+            mStats.candidates += static_cast<long long>(cand.size());
+            mStats.faceCandidates += static_cast<long long>(cand.size());
+            auto tn = std::chrono::steady_clock::now();
+            const Vec3 lo = c0[0].cwiseMin(c0[1]).cwiseMin(c0[2]),
+                       hi = c0[0].cwiseMax(c0[1]).cwiseMax(c0[2]);
+            double first = 2.0;
+            int hitVertex = -1;
+            for (int k : cand) {
+                const int b = mVertices[k];
+                const Vec3 p0 = corner(false, b), p1 = corner(true, b);
+                const Vec3 s0[4] = {p0, c0[0], c0[1], c0[2]};
+                const Vec3 s1[4] = {p1, c1[0], c1[1], c1[2]};
+                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
+                double toi;
+                if (contact::vertexTriangleCcd(p0, p1, c0[0], c1[0], c0[1], c1[1], c0[2], c1[2],
+                                               opt, toi) &&
+                    toi < first) {
+                    first = toi;
+                    hitVertex = b;
+                }
+            }
+            if (hitVertex >= 0) {
+                const Vec3 p0 = corner(false, hitVertex), p1 = corner(true, hitVertex);
+                const Vec3 pt = lerp(p0, p1, first);
+                const Vec3 a = lerp(c0[0], c1[0], first), b = lerp(c0[1], c1[1], first),
+                           c = lerp(c0[2], c1[2], first);
+                double w[3];
+                contact::pointTriangleDistance2(pt, a, b, c, w);
+                const Vec3 qt = w[0] * a + w[1] * b + w[2] * c;
+                // From the cloth towards the body vertex, at τ; touching: the face normal on the
+                // side the vertex started.
+                Vec3 nt = pt - qt;
+                if (!(nt.norm() > 1e-12)) {
+                    const Vec3 fnt = (b - a).cross(c - a);
+                    const Vec3 qs = w[0] * c0[0] + w[1] * c0[1] + w[2] * c0[2];
+                    nt = fnt.dot(p0 - qs) >= 0.0 ? fnt : Vec3(-fnt);
+                }
+                if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
+                nt.normalize();
+                // The side carried to the end of the step with the face; off its interior the
+                // direction to the feature met (the face normal does not separate there).
+                Vec3 n1 = nt;
+                const Vec3 fn1 = (c1[1] - c1[0]).cross(c1[2] - c1[0]);
+                const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
+                if (interior && fn1.norm() > 1e-12) {
+                    n1 = fn1.normalized();
+                    if (n1.dot(nt) < 0.0) n1 = -n1;
+                }
+                double wm[3], norm = 0.0;
+                for (int k = 0; k < 3; ++k) {
+                    wm[k] = movable[tv[k]] ? w[k] : 0.0;
+                    norm += wm[k] * wm[k];
+                }
+                if (!(norm > 1e-12)) {
+                    // Nothing movable carries the point met: the body passes.
+                    stuck[f] = 1;
+                    ++mStats.unresolved;
+                } else {
+                    const Vec3 cloth1 = w[0] * c1[0] + w[1] * c1[1] + w[2] * c1[2];
+                    const double gap = (p1 - cloth1).dot(n1);
+                    if (gap < want) {
+                        const Vec3 d = (-(want - gap) / norm) * n1;
+                        for (int k = 0; k < 3; ++k) vec3At(x1.data(), tv[k]) += wm[k] * d;
+                    }
+                    // The velocity of the cloth point relative to the body vertex's, along the
+                    // normal from the body towards the cloth.
+                    const Vec3 vb = h > 0.0 ? Vec3((p1 - p0) / h) : Vec3::Zero();
+                    const Vec3 nc = -n1;
+                    Vec3 u = -vb;
+                    for (int k = 0; k < 3; ++k) u += w[k] * vec3At(v1.data(), tv[k]);
+                    const double un = u.dot(nc);
+                    if (un < 0.0) {
+                        Vec3 du = -un * nc;
+                        const Vec3 ut = u - un * nc;
+                        const double ts = ut.norm();
+                        if (ts > 0.0) du -= std::min(1.0, friction * (-un) / ts) * ut;
+                        for (int k = 0; k < 3; ++k) vec3At(v1.data(), tv[k]) += (wm[k] / norm) * du;
+                    }
+                    for (int k = 0; k < 3; ++k)
+                        if (wm[k] > 0.0 && !moved[tv[k]]) {
+                            moved[tv[k]] = 1;
+                            ++movedCount;
+                        }
+                    ++hits;
+                    ++mStats.faceHits;
+                }
+            }
+            const double narrow = seconds(tn);
+            mStats.narrowSeconds += narrow;
+            mStats.faceSeconds += broad + narrow;
         }
         if (hits == 0) break;
         if (pass == passes - 1) mStats.unresolved += hits;

@@ -1,8 +1,10 @@
 // Moving and deforming mesh colliders (a MeshSequence): per substep the triangles' corners at
 // both ends of the step, their swept boxes refitted into one AABB tree (built once), closest-point
 // queries at the ends (the in-solve constraints and the thickness push-out, with the surface
-// velocity of the motion), and the continuous pass that keeps cloth from crossing the surface
-// during the step: vertex–triangle and edge–edge CCD (solver/contact/ccd.h) with a thickness.
+// velocity of the motion), the body vertex nearest a cloth triangle (the in-solve side of the
+// body vertex–cloth triangle pair, Body::contactConstraints), and the continuous pass that keeps
+// cloth from crossing the surface during the step: cloth vertex–body triangle, edge–edge and
+// body vertex–cloth triangle CCD (solver/contact/ccd.h) with a thickness.
 #pragma once
 
 #include "solver/contact/bvh.h"
@@ -17,10 +19,13 @@ namespace gale::solver {
 
 struct ContactPoint; // collider.h
 
-// Timings and counts of the contact work (accumulated; bench and run statistics).
+// Timings and counts of the contact work (accumulated; bench and run statistics). The body
+// vertex–cloth triangle pair's share is counted apart as well (`faceSeconds`, its broad and
+// narrow phase, and `faceCandidates` are also in the totals).
 struct MovingContactStats {
-    double refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0;
-    long long refits = 0, candidates = 0, vertexHits = 0, edgeHits = 0, unresolved = 0;
+    double refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0, faceSeconds = 0.0;
+    long long refits = 0, candidates = 0, faceCandidates = 0, vertexHits = 0, edgeHits = 0,
+              faceHits = 0, unresolved = 0;
 };
 
 class MovingMeshContact {
@@ -40,14 +45,25 @@ public:
     // (the mean over the step, m/s). Returns false when nothing is within radius.
     bool closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const;
 
+    // The body vertex nearest to triangle (a, b, c) at the start of the prepared step, searched
+    // within `radius` (m): its position p, the weights w of the triangle's point closest to it,
+    // their distance (m) and the vertex's velocity over the step (m/s). False when none is
+    // within radius. (The in-solve side of the body vertex–cloth triangle pair.)
+    bool nearestVertex(const Vec3& a, const Vec3& b, const Vec3& c, double radius, Vec3& p,
+                       double w[3], double& distance, Vec3& velocity) const;
+
     // The continuous pass over the prepared step for one body: vertex i moves from x0 to x1
-    // (where `movable[i]`), edges as given. Where a vertex or an edge would come within
-    // `thickness` of the moving surface, it is placed at `thickness` off the surface point it
-    // met, as that point is at the step's end, its approach speed removed (relative to the
-    // surface), and Coulomb friction μ applied to the tangential speed. Repeated (at most
-    // `passes` times) until no motion meets the surface. Returns the vertices moved.
+    // (where `movable[i]`), edges and triangles as given (`triangles` empty for hair). Where a
+    // vertex or an edge would come within `thickness` of the moving surface, it is placed at
+    // `thickness` off the surface point it met, as that point is at the step's end, its approach
+    // speed removed (relative to the surface), and Coulomb friction μ applied to the tangential
+    // speed; where a body vertex would come within `thickness` of a cloth triangle, the
+    // triangle's movable corners are moved so that it ends `thickness` off the body vertex, on
+    // the side it started, with the same velocity response at the point it met. Repeated (at
+    // most `passes` times) until no motion meets the surface. Returns the vertices moved.
     int sweep(const VecX& x0, VecX& x1, VecX& v1, const std::vector<uint8_t>& movable,
-              const std::vector<std::array<int, 2>>& edges, double thickness, double friction,
+              const std::vector<std::array<int, 2>>& edges,
+              const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
               double h, int passes = 4);
 
     const MovingContactStats& stats() const { return mStats; }
@@ -58,10 +74,12 @@ private:
 
     std::shared_ptr<const MeshSequence> mMesh;
     std::vector<std::array<int, 2>> mEdges; // unique body edges
+    std::vector<int> mVertices;             // body vertices in some triangle
     std::vector<double> mP0, mP1;           // corners at t0 and t1
     std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
     std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
-    contact::Bvh mBvh, mEdgeBvh;
+    std::vector<contact::Box> mVertexBoxes; // per entry of mVertices, swept over the step
+    contact::Bvh mBvh, mEdgeBvh, mVertexBvh;
     bool mBuilt = false;
     double mT0 = NAN, mT1 = NAN, mMargin = NAN;
     MovingContactStats mStats;

@@ -4,8 +4,12 @@ phase, edge/plane crossings tested against the other triangle by barycentric coo
 optionally the minimum distance between vertex-triangle pairs that share no vertex.
 
 Usage: count_intersections.py [--json] [--min-distance] [--reach=METRES] FRAME.obj...
+       count_intersections.py --pairs [--json] A.obj B.obj [A.obj B.obj...]
 Prints one line per frame (`FILE PAIRS [MIN_DISTANCE]`) and a total; --json prints one object
 {"frames": [{"file", "pairs", "min_distance"?}], "frames_with_intersections", "pairs"} instead.
+--pairs takes the files two at a time (one object's frame and another's at the same time, e.g. a
+cloth and a collider) and counts only pairs of a triangle of A and a triangle of B; the frame is
+named `A+B`.
 Pairs counted: triangles sharing no vertex whose edges cross the other's interior, and triangles
 sharing one vertex whose opposite edge crosses the other (neighbours sharing an edge never count).
 --min-distance looks at pairs within --reach (default: a tenth of the mean edge length); a
@@ -83,9 +87,14 @@ def overlappingBoxes(lo, hi):
     return np.concatenate(I), np.concatenate(J)
 
 
-def countIntersections(V, F):
+def countIntersections(V, F, split=None):
+    """Intersecting pairs among the triangles F; with `split`, only pairs of a triangle below
+    index `split` and one from it on (two objects concatenated)."""
     T = V[F]
     I, J = overlappingBoxes(T.min(1), T.max(1))
+    if split is not None:
+        keep = (I < split) & (J >= split)
+        I, J = I[keep], J[keep]
     shared = F[I][:, :, None] == F[J][:, None, :]
     ns = shared.sum((1, 2))
     hit = np.zeros(len(I), bool)
@@ -155,23 +164,36 @@ def main(argv):
     args = [a for a in argv if not a.startswith('--')]
     flags = {a for a in argv if a.startswith('--') and not a.startswith('--reach=')}
     reaches = [a[len('--reach='):] for a in argv if a.startswith('--reach=')]
-    unknown = flags - {'--json', '--min-distance'}
+    unknown = flags - {'--json', '--min-distance', '--pairs'}
+    pairs = '--pairs' in flags
+    if pairs and ('--min-distance' in flags or len(args) % 2):
+        unknown.add('--pairs (with an odd number of files or --min-distance)')
     try:
         reachArg = float(reaches[-1]) if reaches else None
     except ValueError:
         unknown.add('--reach=' + reaches[-1])
     if unknown or not args:
         sys.stderr.write(f'count_intersections.py: {"unknown option " + min(unknown) if unknown else "no OBJ files"}\n'
-                         'usage: count_intersections.py [--json] [--min-distance] [--reach=METRES] FRAME.obj...\n')
+                         'usage: count_intersections.py [--json] [--min-distance] [--reach=METRES] FRAME.obj...\n'
+                         '       count_intersections.py --pairs [--json] A.obj B.obj [A.obj B.obj...]\n')
         return 2
     frames = []
-    for path in args:
+    for k, path in enumerate(args):
+        if pairs and k % 2:
+            continue
         try:
             V, F = load(path)
+            split = None
+            if pairs:
+                VB, FB = load(args[k + 1])
+                split = len(F)
+                F = np.concatenate([F, FB + len(V)])
+                V = np.concatenate([V, VB])
+                path = path + '+' + args[k + 1]
         except (OSError, ValueError) as e:
             sys.stderr.write(f'count_intersections.py: {e}\n')
             return 2
-        row = {'file': path, 'pairs': countIntersections(V, F)}
+        row = {'file': path, 'pairs': countIntersections(V, F, split)}
         if '--min-distance' in flags:
             # Pairs within a tenth of the mean edge length: far enough for any thickness tested.
             E = V[F[:, [1, 2, 0]]] - V[F]
