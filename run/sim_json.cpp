@@ -157,9 +157,9 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
           << ", \"contact_solve\": {\"constraints\": " << b.contactConstraints
           << ", \"added\": " << b.contactAdded << ", \"released\": " << b.contactReleases
-          << ", \"slid\": " << b.contactSlides
-          << ", \"extra_solves\": " << b.contactSolves << "}, \"contact_projection\": {\"vertices\": "
-          << b.projected << ", \"max_distance\": " << num(b.projectedDistance)
+          << ", \"slid\": " << b.contactSlides << ", \"extra_solves\": " << b.contactSolves
+          << "}, \"contact_projection\": {\"vertices\": " << b.projected
+          << ", \"max_distance\": " << num(b.projectedDistance)
           << ", \"max_speed\": " << num(b.projectedSpeed) << "}";
         if (b.selfIntersections >= 0) o << ", \"self_intersections\": " << b.selfIntersections;
         o

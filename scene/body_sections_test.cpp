@@ -250,9 +250,12 @@ grow_back = "yes"
     const std::string all = bad.all();
     INFO(all);
     const std::string path = (dir.path / "scene.toml").string();
-    CHECK(all.find(path + ":6:16: error: [solver] retry_newton must be at least 0") != std::string::npos);
-    CHECK(all.find(path + ":7:22: error: [solver] retry_cg_tolerance must be below 1") != std::string::npos);
-    CHECK(all.find(path + ":8:13: error: [solver] grow_back must be true or false") != std::string::npos);
+    CHECK(all.find(path + ":6:16: error: [solver] retry_newton must be at least 0") !=
+          std::string::npos);
+    CHECK(all.find(path + ":7:22: error: [solver] retry_cg_tolerance must be below 1") !=
+          std::string::npos);
+    CHECK(all.find(path + ":8:13: error: [solver] grow_back must be true or false") !=
+          std::string::npos);
 }
 
 TEST_CASE("scene: problems found while building are reported where the scene names them", "[scene]") {

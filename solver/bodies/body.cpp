@@ -755,8 +755,8 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
     return rInf;
 }
 
-Trouble Body::predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h, double jumpLimit,
-                               std::string& reason) const {
+Trouble Body::predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h,
+                               double jumpLimit, std::string& reason) const {
     const size_t n = vertexCount();
     const VecX x = x0 + h * (v0 + dv) + mYPos;
     char buf[200];
@@ -1126,7 +1126,8 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     if (st.converged && !mOptions.explicitEuler && mOptions.newtonIterations == 0 &&
         env.retryNewtonIterations > 0) {
         std::string why;
-        const Trouble tr = predictedTrouble(x0, v0, mDv, h, mLimits.velocityJump + 2.0 * (maxWind + pinSpeed), why);
+        const Trouble tr = predictedTrouble(x0, v0, mDv, h,
+                                            mLimits.velocityJump + 2.0 * (maxWind + pinSpeed), why);
         if (tr != Trouble::None) {
             st.retried = tr;
             st.retryReason = why;

@@ -336,8 +336,8 @@ private:
                 const VecX& v0, double h, SubstepStatus& st);
     // The trouble detector's over-stretch and velocity-jump rules on the step's end state
     // x₀ + h(v₀ + Δv) + y before contacts (substep(), 7.); `jumpLimit` in m/s.
-    Trouble predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h, double jumpLimit,
-                             std::string& reason) const;
+    Trouble predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h,
+                             double jumpLimit, std::string& reason) const;
     double mNewtonCgTolerance = 0.0; // Environment::retryCgTolerance while a retry runs
     bool mNewtonKeepCoarse = false;  // Environment::retryKeepCoarse while a retry runs
 

@@ -21,8 +21,8 @@ using namespace gale::solver::testing;
 namespace {
 
 struct OnsetRun {
-    std::vector<int> solves;  // per frame: linear solves (rejected and retried ones too)
-    std::vector<long> cgIts;  // per frame: CG iterations
+    std::vector<int> solves;     // per frame: linear solves (rejected and retried ones too)
+    std::vector<long> cgIts;     // per frame: CG iterations
     std::vector<double> stretch; // per frame: max edge stretch at its end
     int retries = 0, rejected = 0;
 };
@@ -47,7 +47,8 @@ OnsetRun runOnset(int n, int substeps, const WorldSettings& base, int frames = 1
     World world(ws);
     // The scene's wind: 12 m/s gusting ±25 % in bands travelling downwind, 15 % out of plane.
     world.setWind(std::make_shared<LambdaField>([](const Vec3& p, double t) {
-        const double speed = 12.0 * (1.0 + 0.25 * std::sin(2.0 * 3.14159265358979323846 * (1.5 * t - 0.5 * p.x())));
+        const double speed =
+            12.0 * (1.0 + 0.25 * std::sin(2.0 * 3.14159265358979323846 * (1.5 * t - 0.5 * p.x())));
         return Vec3(speed, 0.0, 0.15 * speed);
     }));
     world.addBody(std::move(cloth));
@@ -64,7 +65,8 @@ OnsetRun runOnset(int n, int substeps, const WorldSettings& base, int frames = 1
     return r;
 }
 
-template <typename T> double median(std::vector<T> v) {
+template <typename T>
+double median(std::vector<T> v) {
     std::sort(v.begin(), v.end());
     const size_t k = v.size() / 2;
     return v.size() % 2 ? static_cast<double>(v[k]) : 0.5 * (static_cast<double>(v[k - 1]) + v[k]);
@@ -82,11 +84,11 @@ TEST_CASE("onset: the response to an over-stretching wind onset costs at most 3x
     const std::vector<long> its(r.cgIts.begin() + 2, r.cgIts.end());
     const int worstSolves = *std::max_element(r.solves.begin(), r.solves.end());
     const long worstIts = *std::max_element(r.cgIts.begin(), r.cgIts.end());
-    INFO("solves: onset " << r.solves[0] << ", worst " << worstSolves << ", median " << median(solves)
-                          << "; CG iterations: onset " << r.cgIts[0] << ", worst " << worstIts
-                          << ", median " << median(its) << "; retries " << r.retries << ", rejected "
-                          << r.rejected << "; onset stretch " << r.stretch[0] << ", reference "
-                          << ref.stretch[0]);
+    INFO("solves: onset " << r.solves[0] << ", worst " << worstSolves << ", median "
+                          << median(solves) << "; CG iterations: onset " << r.cgIts[0] << ", worst "
+                          << worstIts << ", median " << median(its) << "; retries " << r.retries
+                          << ", rejected " << r.rejected << "; onset stretch " << r.stretch[0]
+                          << ", reference " << ref.stretch[0]);
     // The onset is in trouble (the linearised step would stretch an edge past 3×): the test
     // exercises the response.
     CHECK(r.retries + r.rejected > 0);
