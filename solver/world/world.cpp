@@ -232,8 +232,10 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
             if (body.positions().allFinite() && body.velocities().allFinite())
                 st.trouble = Trouble::None;
         }
-        // Over-stretch or a velocity jump from the linearised step: first the same substep again
-        // with Newton's line search (which cuts a step that over-stretches), then halving.
+        // WorldSettings::retryRepeat (the response before issue 26's third pass; by default the
+        // retry runs inside Body::substep, above): over-stretch or a velocity jump from the
+        // linearised step first runs the same substep again with Newton's line search (which
+        // cuts a step that over-stretches), then halving.
         const int newton = body.options().newtonIterations;
         const int kRetryNewtonIterations = mSettings.retryNewtonIterations;
         if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
