@@ -61,7 +61,13 @@ std::string settingsJson(const scene::SimScene& sc,
       << ", \"air_density\": " << num(s.airDensity) << ", \"threads\": " << threads
       << ", \"solver\": {\"max_halvings\": " << sc.solver.maxHalvings
       << ", \"over_stretch\": " << num(sc.solver.overStretch)
-      << ", \"velocity_jump\": " << num(sc.solver.velocityJump) << "}";
+      << ", \"velocity_jump\": " << num(sc.solver.velocityJump)
+      << ", \"retry_newton\": " << sc.solver.retryNewton
+      << ", \"retry_cg_tolerance\": " << num(sc.solver.retryCgTolerance)
+      << ", \"retry_keep_coarse\": " << (sc.solver.retryKeepCoarse ? "true" : "false")
+      << ", \"retry_repeat\": " << (sc.solver.retryRepeat ? "true" : "false")
+      << ", \"grow_back\": " << (sc.solver.growBack ? "true" : "false")
+      << ", \"retry_strain_limit\": " << (sc.solver.strainLimit ? "true" : "false") << "}";
     o << ", \"fields\": [";
     for (size_t i = 0; i < sc.wind.fields.size(); ++i)
         o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
@@ -135,6 +141,7 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"newton_retries\": " << b.newtonRetries
           << ", \"deepest_halving\": " << b.deepestHalving
           << ", \"solver_iterations\": " << b.iterations
+          << ", \"linear_solves\": " << b.linearSolves
           << ", \"max_iterations\": " << b.maxIterations
           << ", \"max_residual\": " << num(b.maxResidual)
           << ", \"newton_iterations\": " << b.newtonIterations
@@ -150,9 +157,9 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
           << ", \"contact_solve\": {\"constraints\": " << b.contactConstraints
           << ", \"added\": " << b.contactAdded << ", \"released\": " << b.contactReleases
-          << ", \"slid\": " << b.contactSlides
-          << ", \"extra_solves\": " << b.contactSolves << "}, \"contact_projection\": {\"vertices\": "
-          << b.projected << ", \"max_distance\": " << num(b.projectedDistance)
+          << ", \"slid\": " << b.contactSlides << ", \"extra_solves\": " << b.contactSolves
+          << "}, \"contact_projection\": {\"vertices\": " << b.projected
+          << ", \"max_distance\": " << num(b.projectedDistance)
           << ", \"max_speed\": " << num(b.projectedSpeed) << "}";
         if (b.selfIntersections >= 0) o << ", \"self_intersections\": " << b.selfIntersections;
         o

@@ -49,7 +49,9 @@ const std::vector<std::string> kHairKeys = withStepKeys(
 const std::vector<std::string> kColliderKeys = {
     "name", "type",      "center",   "radius", "point", "normal",   "a",
     "b",    "thickness", "friction", "mesh",   "voxel", "rest_mesh"};
-const std::vector<std::string> kSolverKeys = {"max_halvings", "over_stretch", "velocity_jump"};
+const std::vector<std::string> kSolverKeys = {
+    "max_halvings",      "over_stretch", "velocity_jump", "retry_newton",      "retry_cg_tolerance",
+    "retry_keep_coarse", "retry_repeat", "grow_back",     "retry_strain_limit"};
 
 class Loader : public TomlReader {
 public:
@@ -699,6 +701,23 @@ void Loader::loadSolver(const toml::table& t, SolverSection& s) {
     }
     if (const toml::node* n = t.get("over_stretch")) number(*n, "[solver] over_stretch", s.overStretch, 1.0, true);
     if (const toml::node* n = t.get("velocity_jump")) number(*n, "[solver] velocity_jump (m/s)", s.velocityJump, 0.0, true);
+    if (const toml::node* n = t.get("retry_newton")) {
+        long long v = 0;
+        if (integer(*n, "[solver] retry_newton", v, 0))
+            s.retryNewton = static_cast<int>(std::min(v, 100LL));
+    }
+    if (const toml::node* n = t.get("retry_cg_tolerance")) {
+        if (number(*n, "[solver] retry_cg_tolerance", s.retryCgTolerance, 0.0, false) &&
+            s.retryCgTolerance >= 1.0)
+            error(*n, "[solver] retry_cg_tolerance must be below 1 (a relative residual)");
+    }
+    if (const toml::node* n = t.get("retry_keep_coarse"))
+        boolean(*n, "[solver] retry_keep_coarse", s.retryKeepCoarse);
+    if (const toml::node* n = t.get("retry_repeat"))
+        boolean(*n, "[solver] retry_repeat", s.retryRepeat);
+    if (const toml::node* n = t.get("grow_back")) boolean(*n, "[solver] grow_back", s.growBack);
+    if (const toml::node* n = t.get("retry_strain_limit"))
+        boolean(*n, "[solver] retry_strain_limit", s.strainLimit);
 }
 
 void Loader::load(const toml::table& root, const std::string& baseDir, SimScene& out) {

@@ -208,6 +208,56 @@ max_halvings = 2.5
     CHECK(all.find("max_halvings must be a whole number") != std::string::npos);
 }
 
+TEST_CASE("scene: the response to trouble ([solver] retry keys) is read and checked", "[scene]") {
+    TempDir dir;
+    Loaded ok = load(dir, R"([[cloth]]
+name = "c"
+grid = { size = [1, 1], res = [4, 4] }
+
+[solver]
+retry_newton = 2
+retry_cg_tolerance = 0.05
+retry_keep_coarse = true
+retry_repeat = true
+grow_back = true
+retry_strain_limit = true
+)");
+    INFO(ok.all());
+    REQUIRE(ok.ok);
+    CHECK(ok.scene.solver.retryNewton == 2);
+    CHECK(ok.scene.solver.retryCgTolerance == 0.05);
+    CHECK(ok.scene.solver.retryKeepCoarse);
+    CHECK(ok.scene.solver.retryRepeat);
+    CHECK(ok.scene.solver.growBack);
+    CHECK(ok.scene.solver.strainLimit);
+    const WorldSettings ws = worldSettings(ok.scene, 1);
+    CHECK(ws.retryNewtonIterations == 2);
+    CHECK(ws.retryCgTolerance == 0.05);
+    CHECK(ws.retryRepeat);
+    CHECK(ws.growBack);
+    CHECK(ws.strainLimitRetry);
+
+    Loaded bad = load(dir, R"([[cloth]]
+name = "c"
+grid = { size = [1, 1], res = [4, 4] }
+
+[solver]
+retry_newton = -1
+retry_cg_tolerance = 1.5
+grow_back = "yes"
+)");
+    CHECK_FALSE(bad.ok);
+    const std::string all = bad.all();
+    INFO(all);
+    const std::string path = (dir.path / "scene.toml").string();
+    CHECK(all.find(path + ":6:16: error: [solver] retry_newton must be at least 0") !=
+          std::string::npos);
+    CHECK(all.find(path + ":7:22: error: [solver] retry_cg_tolerance must be below 1") !=
+          std::string::npos);
+    CHECK(all.find(path + ":8:13: error: [solver] grow_back must be true or false") !=
+          std::string::npos);
+}
+
 TEST_CASE("scene: problems found while building are reported where the scene names them", "[scene]") {
     TempDir dir;
     Loaded l = load(dir, R"([[cloth]]

@@ -265,6 +265,12 @@ WorldSettings worldSettings(const SimScene& scene, int threads) {
     ws.timeZero = s.timeZero;
     ws.substeps = s.substeps;
     ws.maxHalvings = scene.solver.maxHalvings;
+    ws.retryNewtonIterations = scene.solver.retryNewton;
+    ws.retryCgTolerance = scene.solver.retryCgTolerance;
+    ws.retryKeepCoarse = scene.solver.retryKeepCoarse;
+    ws.retryRepeat = scene.solver.retryRepeat;
+    ws.growBack = scene.solver.growBack;
+    ws.strainLimitRetry = scene.solver.strainLimit;
     if (s.gravity.size() >= 3) ws.gravity = Vec3(s.gravity[0], s.gravity[1], s.gravity[2]);
     ws.airDensity = s.airDensity;
     ws.threads = threads;

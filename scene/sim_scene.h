@@ -100,6 +100,14 @@ struct SolverSection {
     int maxHalvings = 6;
     double overStretch = 3.0;
     double velocityJump = 50.0;
+    // The response to a substep in trouble (solver::WorldSettings::retry*, growBack,
+    // strainLimitRetry; the defaults are WorldSettings').
+    int retryNewton = solver::WorldSettings{}.retryNewtonIterations;
+    double retryCgTolerance = solver::WorldSettings{}.retryCgTolerance;
+    bool retryKeepCoarse = solver::WorldSettings{}.retryKeepCoarse;
+    bool retryRepeat = solver::WorldSettings{}.retryRepeat;
+    bool growBack = solver::WorldSettings{}.growBack;
+    bool strainLimit = false;
 };
 
 struct SimScene {

@@ -801,6 +801,32 @@ double Body::residualAt(const VecX& dv, const VecX& x0, const VecX& v0, double h
     return rInf;
 }
 
+Trouble Body::predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h,
+                               double jumpLimit, std::string& reason) const {
+    const size_t n = vertexCount();
+    const VecX x = x0 + h * (v0 + dv) + mYPos;
+    char buf[200];
+    const double stretch = mEdges.empty() ? 0.0 : maxEdgeStretchOf(x);
+    if (stretch > mLimits.overStretch && stretch > 1.05 * mStretchBefore) {
+        std::snprintf(buf, sizeof buf, "an edge would reach %.3g× its rest length (limit %.3g×)",
+                      stretch, mLimits.overStretch);
+        reason = buf;
+        return Trouble::OverStretch;
+    }
+    double maxJump = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        if (!mHeld[i] && (mConstraints.kind[i] != 1 || mContactCollider[i] >= 0))
+            maxJump = std::max(maxJump, vec3At(dv.data(), i).norm());
+    if (maxJump > jumpLimit) {
+        std::snprintf(buf, sizeof buf,
+                      "a vertex would change speed by %.3g m/s in one substep (limit %.3g m/s)",
+                      maxJump, jumpLimit);
+        reason = buf;
+        return Trouble::VelocityJump;
+    }
+    return Trouble::None;
+}
+
 bool Body::stretchFeasible(const VecX& x) const {
     // The over-stretch detector's rule (substep()): trouble when an edge exceeds the limit and
     // the largest stretch grew by more than 5 %. The line search takes no step into it.
@@ -915,10 +941,15 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         mGk = mF - mFel;
         rhs = -mG;
         delta.setZero();
-        // (Options::newtonKeepCoarse: the linearised step's coarse levels, level 0 refreshed.)
-        mSolver.setKeepCoarse(mOptions.newtonKeepCoarse);
+        // (Options::newtonKeepCoarse: the linearised step's coarse levels, level 0 refreshed;
+        // a retry's keepCoarse: its first solve's.)
+        mSolver.setKeepCoarse(mOptions.newtonKeepCoarse || (mNewtonKeepCoarse && k > 0));
+        const double tolerance = mOptions.cgTolerance;
+        if (mNewtonCgTolerance > 0.0) mOptions.cgTolerance = mNewtonCgTolerance;
         const SolveStatus ns = solveLinear(rhs, delta);
+        mOptions.cgTolerance = tolerance;
         mSolver.setKeepCoarse(false);
+        ++st.linearSolves;
         st.iterations += ns.iterations;
         st.residual = std::max(st.residual, ns.residual);
         ++st.newtonIterations;
@@ -1130,9 +1161,34 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     st.residual = ls.residual;
     st.converged = ls.converged && !ls.failed;
 
+    if (!mOptions.explicitEuler) st.linearSolves = 1 + st.contactSolves;
+
     // 5. Newton on the backward-Euler residual, from the linearised solve as the first iterate.
     if (st.converged && !mOptions.explicitEuler && mOptions.newtonIterations > 0)
         newton(env, in, out, x0, v0, h, st);
+    // ... or, when the linearised step alone is in trouble by the detector's rules (7.), the
+    // retry: Newton from it on the same substep, its line search cutting what over-stretches
+    // (Environment::retryNewtonIterations; the SPD iterates: the cut, not convergence, is its job).
+    if (st.converged && !mOptions.explicitEuler && mOptions.newtonIterations == 0 &&
+        env.retryNewtonIterations > 0) {
+        std::string why;
+        const Trouble tr = predictedTrouble(x0, v0, mDv, h,
+                                            mLimits.velocityJump + 2.0 * (maxWind + pinSpeed), why);
+        if (tr != Trouble::None) {
+            st.retried = tr;
+            st.retryReason = why;
+            const bool full = mOptions.newtonFullJacobian;
+            mOptions.newtonIterations = env.retryNewtonIterations;
+            mOptions.newtonFullJacobian = false;
+            mNewtonCgTolerance = env.retryCgTolerance;
+            mNewtonKeepCoarse = env.retryKeepCoarse;
+            newton(env, in, out, x0, v0, h, st);
+            mOptions.newtonIterations = 0;
+            mOptions.newtonFullJacobian = full;
+            mNewtonCgTolerance = 0.0;
+            mNewtonKeepCoarse = false;
+        }
+    }
     mDvGuess = mDv;
     mHGuess = h;
     mV = v0 + mDv;

@@ -103,6 +103,18 @@ struct Environment {
     double frameZero = 0.0; // the frame at t = 0 ($frame = t · fps + frameZero)
     int threads = 1;
     int substepIndex = 0;
+    // The in-substep retry of a linearised step in trouble (World::stepBody; docs/solver.md,
+    // Robust substepping): when the linearised step's end state would over-stretch an edge or
+    // jump a vertex's speed (the trouble detector's rules), at most `retryNewtonIterations`
+    // Newton iterations (SPD iterates, their line search keeping every iterate
+    // stretch-feasible) from it, without solving the linearised step again, each correction
+    // solved to `retryCgTolerance` (0: cg_tolerance). 0 iterations: no retry here. Ignored
+    // when newton_iterations > 0 (Newton runs anyway).
+    int retryNewtonIterations = 0;
+    double retryCgTolerance = 0.0;
+    // The retry's solves after its first keep the multigrid's coarse levels of its first solve
+    // (level 0 refreshed; smoothed aggregation only).
+    bool retryKeepCoarse = false;
 };
 
 // Contact settings of a body (cloth): cloth–cloth collision (solver/world/self_collision.h) and the
@@ -129,6 +141,11 @@ struct SubstepStatus {
     double newtonResidual = 0.0; // m/s: the largest free vertex's velocity residual at the end
     int lineSearchCuts = 0;      // step halvings of the Newton line search
     bool newtonStalled = false;  // stopped above the tolerance: no step lowered the merit
+    // The linearised step was in trouble and retried inside the substep with Newton
+    // (Environment::retryNewtonIterations): what it was, and why.
+    Trouble retried = Trouble::None;
+    std::string retryReason;
+    int linearSolves = 0; // solves with a fresh matrix (linearised step, contact rounds, Newton)
     size_t windNonFinite = 0;    // wind samples that came back NaN/inf (replaced by zero)
     std::string windMessage;
     int clampedJacobians = 0; // paper Jacobian with C_D < C_L, clamped
@@ -317,6 +334,12 @@ private:
     double elasticAt(const VecX& x, double t, VecX& fEl);
     void newton(const Environment& env, ForceInput& in, ForceOutput& out, const VecX& x0,
                 const VecX& v0, double h, SubstepStatus& st);
+    // The trouble detector's over-stretch and velocity-jump rules on the step's end state
+    // x₀ + h(v₀ + Δv) + y before contacts (substep(), 7.); `jumpLimit` in m/s.
+    Trouble predictedTrouble(const VecX& x0, const VecX& v0, const VecX& dv, double h,
+                             double jumpLimit, std::string& reason) const;
+    double mNewtonCgTolerance = 0.0; // Environment::retryCgTolerance while a retry runs
+    bool mNewtonKeepCoarse = false;  // Environment::retryKeepCoarse while a retry runs
 
     StepKinematics mKin; // the substep's scripted motion (evaluateKinematics)
     std::vector<int> mPinned; // vertex per pin

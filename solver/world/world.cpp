@@ -198,6 +198,10 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
     env.fps = mSettings.fps;
     env.frameZero = mSettings.timeZero;
     env.threads = mSettings.threads;
+    const bool inSubstep = !mSettings.retryRepeat && !mSettings.noNewtonRetry;
+    env.retryNewtonIterations = inSubstep ? std::max(mSettings.retryNewtonIterations, 0) : 0;
+    env.retryCgTolerance = mSettings.retryCgTolerance;
+    env.retryKeepCoarse = mSettings.retryKeepCoarse;
     long& tick = run.tick;
     int& level = run.level;
     int& index = run.index;
@@ -209,12 +213,33 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         env.substepIndex = index;
         const Body::Snapshot snap = body.snapshot();
         SubstepStatus st = body.substep(env, t, h);
-        // Over-stretch or a velocity jump from the linearised step: first the same substep again
-        // with Newton's line search (which cuts a step that over-stretches), then halving.
+        if (st.retried != Trouble::None) {
+            ++stats.newtonRetries;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s); substep retried with %d Newton iteration(s): %s", t,
+                          troubleName(st.retried), st.retryReason.c_str(), st.newtonIterations,
+                          st.trouble == Trouble::None ? "accepted" : "still in trouble");
+            stats.events.push_back(buf);
+        }
+        if (mSettings.strainLimitRetry &&
+            (st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump)) {
+            const int fixes = body.recover(snap, h);
+            ++stats.recovered;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: %s (%s); strain limited (%d edge correction(s))", t,
+                          troubleName(st.trouble), st.reason.c_str(), fixes);
+            stats.events.push_back(buf);
+            if (body.positions().allFinite() && body.velocities().allFinite())
+                st.trouble = Trouble::None;
+        }
+        // WorldSettings::retryRepeat (the response before issue 26's third pass; by default the
+        // retry runs inside Body::substep, above): over-stretch or a velocity jump from the
+        // linearised step first runs the same substep again with Newton's line search (which
+        // cuts a step that over-stretches), then halving.
         const int newton = body.options().newtonIterations;
         const int kRetryNewtonIterations = mSettings.retryNewtonIterations;
         if ((st.trouble == Trouble::OverStretch || st.trouble == Trouble::VelocityJump) &&
-            newton < kRetryNewtonIterations && !mSettings.noNewtonRetry) {
+            newton < kRetryNewtonIterations && !mSettings.noNewtonRetry && mSettings.retryRepeat) {
             std::snprintf(buf, sizeof buf,
                           "t=%.6g s: %s (%s); substep retried with %d Newton iterations", t,
                           troubleName(st.trouble), st.reason.c_str(), kRetryNewtonIterations);
@@ -225,16 +250,19 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
             body.options().newtonIterations = kRetryNewtonIterations;
             body.options().newtonFullJacobian = false;
             const int firstIterations = st.iterations;
+            const int firstSolves = st.linearSolves;
             st = body.substep(env, t, h);
             body.options().newtonIterations = newton;
             body.options().newtonFullJacobian = full;
             st.iterations += firstIterations;
+            st.linearSolves += firstSolves;
             ++stats.newtonRetries;
             stats.events.push_back(std::string(buf) + (st.trouble == Trouble::None
                                                            ? ": accepted"
                                                            : ": still in trouble"));
         }
         stats.iterations += st.iterations;
+        stats.linearSolves += st.linearSolves;
         stats.maxIterations = std::max(stats.maxIterations, st.iterations);
         stats.maxResidual = std::max(stats.maxResidual, st.residual);
         stats.clampedJacobians += st.clampedJacobians;
@@ -254,6 +282,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
             if (level < maxLevel) {
                 body.restore(snap);
                 ++level;
+                run.streak = 0;
                 ++stats.rejected;
                 stats.deepestHalving = std::max(stats.deepestHalving, level);
                 std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep halved to %.6g s", t,
@@ -290,6 +319,14 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         stats.projectedSpeed = std::max(stats.projectedSpeed, st.projectedSpeed);
         ++stats.substeps;
         ++index;
+        // Grow back (WorldSettings::growBack): two accepted substeps at this level and a
+        // boundary of the coarser one.
+        ++run.streak;
+        if (mSettings.growBack && level > 0 && run.streak >= 2 &&
+            tick % (ticksPerBase >> (level - 1)) == 0) {
+            --level;
+            run.streak = 0;
+        }
     }
 }
 

@@ -24,11 +24,25 @@ struct WorldSettings {
     double airDensity = 1.225;  // kg/m³
     int threads = 1;            // 0: all hardware threads; results do not depend on it
     bool noNewtonRetry = false; // tests and benchmarks of the raw halving: no Newton retry
-    // Newton iterations of the retry of a substep in trouble (World::stepBody). Fewer make the
-    // onset frame cheaper but not reliably better (bench/README.md, issue 26: at 64² 1 gives
-    // worst/median 2.0× but a larger max stretch there and on hard_test's flags; 2 and 4 do not
-    // reach 3×), so it stays 16.
-    int retryNewtonIterations = 16;
+    // The response to a substep whose linearised step over-stretches or jumps a vertex's speed
+    // (docs/solver.md, Robust substepping; bench/README.md, issue 26, third pass): at most
+    // retryNewtonIterations Newton iterations (0: no retry, halve at once), run inside the
+    // substep from its linearised step (Environment::retry*), each correction solved to
+    // retryCgTolerance (0: the body's cg_tolerance); retryKeepCoarse: the retry's solves after
+    // its first keep that solve's coarse multigrid levels. With retryRepeat the substep is
+    // instead run again from its start with that many Newton iterations at full tolerance (the
+    // response before issue 26's third pass: 16 iterations, ~20× a median frame's work).
+    int retryNewtonIterations = 4;
+    double retryCgTolerance = 0.1;
+    bool retryKeepCoarse = false;
+    bool retryRepeat = false;
+    // A halved substep grows back: after two accepted substeps at a level, at a boundary of
+    // the next coarser one, the step doubles again (down to the base size). Off: the halved
+    // step holds to the end of the frame.
+    bool growBack = false;
+    // Over-stretch or a velocity jump is answered by strain limiting the step (Body::recover,
+    // as at the smallest substep) instead of a retry or halving (measured, not the default).
+    bool strainLimitRetry = false;
 };
 
 // Per body, per frame.
@@ -40,6 +54,7 @@ struct BodyFrameStats {
     int newtonRetries = 0;  // substeps in trouble retried with Newton before halving
     int deepestHalving = 0; // 0: every substep at the base size
     long iterations = 0;    // linear-solver iterations, summed over substeps
+    int linearSolves = 0;   // linear solves with a fresh matrix, summed (rejected ones too)
     int maxIterations = 0;  // the most in one substep
     double maxResidual = 0.0;
     int newtonIterations = 0;       // Newton corrections after the linearised solves, summed
@@ -115,6 +130,7 @@ private:
         long tick = 0;
         int level = 0;
         int index = 0;
+        int streak = 0; // substeps accepted at `level` since it last changed
         bool stopped = false;
     };
     void advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats);
