@@ -4,9 +4,9 @@
 python3 and numpy only, no downloaded assets. The body is ONE closed skin: a low-poly cage
 (a torso of 10-vertex rings with the legs, the arms and the neck and head extruded from its
 faces, as a modeller box-models a body) smoothed by two levels of Catmull-Clark subdivision
-and triangulated (3,328 triangles). Every cage vertex carries linear-blend-skinning weights on
-a skeleton of 19 joints (pelvis, spine, chest, neck, head; clavicles, upper arms, forearms and
-hands; thighs, shins and feet), 50/50 across each elbow, wrist, knee and ankle ring and
+and triangulated (2,818 vertices, 5,632 triangles). Every cage vertex carries
+linear-blend-skinning weights on a skeleton of 19 joints (pelvis, spine, chest, neck, head;
+clavicles, upper arms, forearms and hands; thighs, shins and feet), 50/50 across each elbow, wrist, knee and ankle ring and
 blended round the shoulders and hips; subdividing the weights with the positions spreads them
 smoothly across every joint, so the skin bends and stretches there as a rigged character's
 does (v = sum_j w_j M_j v_rest, M_j the joint's world transform from the rest pose).
@@ -23,12 +23,13 @@ its rest (bind) pose at the origin, which the scene's pre-roll eases the body fr
 
 The cape (cape.obj) is modelled on the rest pose: a 17 x 25 vertex sheet whose top row runs
 round the back of the neck from one side of it to the other (the collar, 1.5 cm off the skin),
-over the shoulders and down the back to the knees, kept at least 2 cm off the skin everywhere.
-The ponytail (hair.csv, x,y,z,strand, root first): 30 strands of 12 segments (0.24 m) rooted
-5 mm off the back of the head, combed back and hanging down (the polyline is the rest shape).
+over the shoulders and down the back to mid-thigh, kept at least 2 cm off the skin everywhere.
+The ponytail (hair.csv, x,y,z,strand, root first): 30 strands of 16 segments (0.36 m) rooted
+1.5 cm off the back of the head (at its tie), combed back and hanging down (the polyline is
+the rest shape).
 
-    python3 make_character.py [folder]      (default: body/; writes cape.obj, cape_collar.txt and
-                                             hair.csv in the current directory)
+    python3 make_character.py [folder]      (default: body/; writes cape.obj and hair.csv in the
+                                             current directory)
 """
 import math
 import os
@@ -483,9 +484,9 @@ def cape(V, T):
     return P, np.array(F), collar
 
 
-def ponytail(V, T, strands=30, segments=12, length=0.24):
-    """Roots on the back of the head round (0, 1.72, back), 5 mm off the skin, then combed
-    back 2 cm and hanging down behind the neck."""
+def ponytail(V, T, strands=30, segments=16, length=0.36):
+    """Roots on the back of the head round (0, 1.73, back), ROOT_OFFSET off the skin, combed
+    back over the first third and then hanging down behind the neck onto the cape."""
     pts = []
     for s in range(strands):
         ring, k = divmod(s, 10)

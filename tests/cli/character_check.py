@@ -72,17 +72,22 @@ def closed(F):
     return bool((c == 1).all() and np.isin(rev, u).all())
 
 
-def winding(P, V, F, chunk=48):
-    """Generalised winding numbers of the points P about the triangle mesh (V, F)."""
-    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+def winding(P, V, F, chunk=8):
+    """Generalised winding numbers of the points P about the triangle mesh (V, F): each
+    triangle's signed solid angle by Van Oosterom and Strackee's formula,
+    tan(Omega/2) = a.(b x c) / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|)."""
+    A, B, C = (V[F[:, k]].T.copy() for k in range(3))  # 3 x m each
     out = np.zeros(len(P))
     for s in range(0, len(P), chunk):
-        p = P[s:s + chunk, None, :]
-        a, b, c = A[None] - p, B[None] - p, C[None] - p
-        la, lb, lc = (np.linalg.norm(x, axis=2) for x in (a, b, c))
-        num = np.einsum('pti,pti->pt', a, np.cross(b, c))
-        den = (la * lb * lc + np.einsum('pti,pti->pt', a, b) * lc + np.einsum('pti,pti->pt', b, c) * la
-               + np.einsum('pti,pti->pt', c, a) * lb)
+        p = P[s:s + chunk]
+        a = [A[k][None, :] - p[:, k:k + 1] for k in range(3)]
+        b = [B[k][None, :] - p[:, k:k + 1] for k in range(3)]
+        c = [C[k][None, :] - p[:, k:k + 1] for k in range(3)]
+        dot = lambda u, v: u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+        la, lb, lc = np.sqrt(dot(a, a)), np.sqrt(dot(b, b)), np.sqrt(dot(c, c))
+        num = (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2])
+               + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb
         out[s:s + chunk] = np.arctan2(num, den).sum(1) / (2 * np.pi)
     return out
 
