@@ -15,7 +15,7 @@ The walk: 1.0 stride/s at 1.2 m/s, thighs swinging +-24 degrees with the knees f
 the swing, arms swinging +-22 degrees against the legs with the elbows bending, the pelvis
 bobbing 2 cm, swaying 2.5 cm and twisting against the chest, the head nodding; and a 50 degree
 turn to the character's left (towards +x) between 0.5 s and 1.4 s. It faces +z at first, feet
-at y = 0, 1.80 m tall.
+at y = 0, 1.84 m tall.
 
 Shot frames as a cache has them: frame F is at t = (F - 1001) / fps, written for 1000 ... 1049
 (the shot is 1001-1048, one frame of handle on each side), plus body/rest.obj: the same skin in
