@@ -7,8 +7,8 @@
 // solve the nonlinear backward-Euler residual r(v₁) = M(v₁ − v₀) − h f(x₀ + h v₁, v₁) with the
 // same matrix re-evaluated at the iterate. The wind is sampled once per substep, at x₀.
 #include "solver/bodies/body.h"
-#include "solver/mesh/mesh_sequence.h"
 #include "solver/collider/moving_collider.h"
+#include "solver/mesh/mesh_sequence.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,9 +31,11 @@ constexpr int kContactRounds = 8;
 // fraction of the thickness above it (it lands on the plane during the step).
 constexpr double kContactBand = 0.5;
 // A sliding contact's friction that changed by less than this fraction asks for no new solve.
-constexpr double kFrictionChange = 0.1;
-// m/s: a slip slower than this has no direction of its own.
-constexpr double kSlipSlop = 1e-6;
+constexpr double kFrictionChange = 0.01;
+// m/s: the slip speed below which implicit friction holds a sliding contact like a viscous
+// stick (IPC's ε_v, Li et al. 2020 §5: the friction force μ λ_n v_t / max(|v_t|, ε_v)); a
+// contact sliding slower creeps at most this fast under Coulomb's full force.
+constexpr double kSlipFloor = 1e-3;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
 } // namespace
@@ -102,8 +104,8 @@ void Body::addPins(const PinSet& pins) {
         mPinned.push_back(v);
         mPinSet.push_back(set);
         mPinBinding.push_back(pins.attach && !pins.attach->triangles().empty()
-                                  ? std::make_shared<const SurfaceBinding>(
-                                        bindToSurface(*pins.attach, vec3At(mX.data(), v), pins.bindTime))
+                                  ? std::make_shared<const SurfaceBinding>(bindToSurface(
+                                        *pins.attach, vec3At(mX.data(), v), pins.bindTime))
                                   : nullptr);
         const Vec3 p = vec3At(mX.data(), v);
         mAnchor.conservativeResize(mAnchor.size() + 3);
@@ -289,6 +291,7 @@ void Body::setContact(size_t i, int ci, const ContactPoint& cp, const Vec3& p, d
     vec3At(mConstraints.z.data(), i) = stick ? z : Vec3(nrm * z.dot(nrm));
     vec3At(mYPos.data(), i) = nrm * std::max(gap, 0.0);
     vec3At(mFriction.data(), i).setZero();
+    mFrictionDamping[i] = 0.0;
     vec3At(mContactVelocity.data(), i) = cp.velocity;
     mContactSpeed[i] = vsn;
     mContactCollider[i] = ci;
@@ -330,7 +333,11 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     mStickVelocity.setZero(3 * n);
     mContactMu.assign(n, 0.0);
     mFoundInside.assign(n, 0);
-    mFrictionCap.assign(n, std::numeric_limits<double>::infinity());
+    // A is assembled anew for the substep: no friction in it.
+    mFrictionDamping.assign(n, 0.0);
+    mFrictionPrev.assign(2 * n, 0.0);
+    mFrictionInA.assign(n, 0.0);
+    mFrictionAxis.setZero(3 * n);
     if (!env.colliders || env.colliders->empty()) return;
     for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
         const Collider& c = (*env.colliders)[ci];
@@ -414,8 +421,10 @@ void Body::landed() {
         const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
         Eigen::Map<Vec3> v(mV.data() + 3 * i);
         const double removed = v.dot(nrm) - mContactSpeed[i];
-        if (mConstraints.kind[i] == 1) v = vec3At(mContactVelocity.data(), i); // stuck
-        else v -= nrm * removed;
+        if (mConstraints.kind[i] == 1)
+            v = vec3At(mContactVelocity.data(), i); // stuck
+        else
+            v -= nrm * removed;
         mContactImpulse[i] += std::max(0.0, -removed);
     }
 }
@@ -447,16 +456,20 @@ void Body::contactRhs(double h) {
 // - λ_n < 0 (the contact pulls): released, for the rest of the substep (not a contact made
 //   because the vertex ended a solve inside);
 // - sticking and |λ_t| > μ λ_n (more friction than Coulomb allows): sliding, S = I − nnᵀ, with
-//   a friction impulse f in b against the slip v_t − v_s,t of the latest solve, lagged by one
-//   solve and bounded: |f| ≤ min(μ λ_n, |λ_t| of the stick) — less than what held it, so it
-//   slows the slip; a slip that turns to run along f (f overshot, it would push) halves f
-//   instead of flipping it (no chatter);
+//   Coulomb friction implicit in the solve (syncFriction): the friction impulse on the relative
+//   tangential velocity at the step's end, −c P (v₁ − v_s), P = I − nnᵀ, with
+//   c = μ λ_n / max(|v_t|, ε_v) (kg) lagged from the latest solve (λ_n and the slip |v_t|), so
+//   its magnitude is μ λ_n when the slip settles (the lagged friction of Li et al. 2020, §5).
+//   c P is a positive semi-definite damping added to A: whatever λ_n is, the friction can slow
+//   the slip to zero but never reverse it or add energy (an impulse lagged in b instead can
+//   exceed what stops a light vertex by orders of magnitude: hair, 1e-7 kg a vertex, behind
+//   a stiff spring's normal impulse);
 // - a free vertex that ends the step within a collider's thickness moving in (relative to the
 //   surface) gets a contact plane from the query at its end position, at t + h (sticking when
 //   the collider has friction).
 // Returns the number of changes (each asks for another solve).
-int Body::updateContacts(const Environment& env, double t, double h, const VecX& x0,
-                         const VecX& v0, SubstepStatus& st) {
+int Body::updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
+                         SubstepStatus& st) {
     if (!env.colliders || env.colliders->empty()) return 0;
     const size_t n = vertexCount();
     int changes = 0;
@@ -469,11 +482,10 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         const Vec3 lambda = vec3At(mTmp.data(), i);
         const double ln = lambda.dot(nrm); // N·s
         Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
-        Eigen::Map<Vec3> fr(mFriction.data() + 3 * i);
         if (ln < 0.0 && !mFoundInside[i]) {
             mConstraints.kind[i] = 0;
             z.setZero();
-            fr.setZero();
+            mFrictionDamping[i] = 0.0;
             vec3At(mYPos.data(), i).setZero();
             mContactCollider[i] = -1;
             mContactImpulse[i] = 0.0;
@@ -487,39 +499,37 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             const Vec3 lt = lambda - nrm * ln;
             const double ltn = lt.norm();
             if (ltn > mu * ln * (1.0 + 1e-9) && ltn > 0.0) {
-                // Against the slip relative to the surface when the sticking motion has one
-                // (a vertex that slides onto the plane), else along the holding impulse.
-                const Vec3 rel = vec3At(mStickVelocity.data(), i) -
-                                 vec3At(mContactVelocity.data(), i);
-                const Vec3 slip = rel - nrm * rel.dot(nrm);
-                const double slipN = slip.norm();
+                // The first slide is frictionless: its slip bounds the true one from above,
+                // and the lagged c = μ λ_n / |v_t| then converges from above (each further
+                // solve slows the slip towards Coulomb's; from below, from a resting slip of
+                // ε_v, the slip would grow only by tan θ / μ a solve).
                 mConstraints.kind[i] = 2;
                 z = nrm * z.dot(nrm);
-                fr = slipN > kSlipSlop ? Vec3(-(mu * ln / slipN) * slip)
-                                       : Vec3((mu * ln / ltn) * lt);
-                mFrictionCap[i] = ltn;
+                mFrictionDamping[i] = 0.0;
+                mFrictionPrev[2 * i] = mFrictionPrev[2 * i + 1] = 0.0;
                 ++st.contactSlides;
                 ++changes;
             }
-        } else if (mu > 0.0) { // sliding
-            const Vec3 rel = vec3At(v0.data(), i) + vec3At(mDv.data(), i) -
-                             vec3At(mContactVelocity.data(), i);
-            const Vec3 slip = rel - nrm * rel.dot(nrm);
-            const double slipN = slip.norm();
-            const double frN = fr.norm();
-            if (frN > 0.0 && slip.dot(fr) > 0.0) {
-                // The slip turned to run along the friction: it overshot the sticking impulse
-                // (which lies between 0 and fr). Halve it rather than flip it (no chatter).
-                fr *= 0.5;
-                mFrictionCap[i] = fr.norm();
-                ++changes;
-            } else {
-                const Vec3 dir = slipN > 0.0 ? Vec3(-slip / slipN)
-                                             : (frN > 0.0 ? Vec3(fr / frN) : Vec3::Zero());
-                const Vec3 next = std::min(std::max(mu * ln, 0.0), mFrictionCap[i]) * dir;
-                if ((next - fr).norm() > kFrictionChange * std::max(frN, mu * ln)) ++changes;
-                fr = next;
+        } else if (mu > 0.0) { // sliding: c from this solve's normal impulse and slip
+            const Vec3 rel =
+                vec3At(v0.data(), i) + vec3At(mDv.data(), i) - vec3At(mContactVelocity.data(), i);
+            const double slipN = std::max((rel - nrm * rel.dot(nrm)).norm(), kSlipFloor);
+            const double bound = std::max(mu * ln, 0.0); // Coulomb's impulse (N·s)
+            const double now = mFrictionDamping[i];
+            double next = bound / slipN; // Picard: the lagged c
+            // Secant on the vertex's own response, slip = p / (m + c) through this solve's
+            // (c, slip) and the previous one's: c with c·slip(c) = μ λ_n (Aitken's step; the
+            // plain lag converges only by the factor μ λ_n / p a solve).
+            const double cPrev = mFrictionPrev[2 * i], sPrev = mFrictionPrev[2 * i + 1];
+            if (sPrev > slipN * (1.0 + 1e-6) && now > cPrev) {
+                const double m = (now * slipN - cPrev * sPrev) / (sPrev - slipN);
+                const double p = slipN * (m + now);
+                if (m > 0.0) next = p > bound ? bound * m / (p - bound) : bound / kSlipFloor;
             }
+            mFrictionPrev[2 * i] = now;
+            mFrictionPrev[2 * i + 1] = slipN;
+            if (std::abs(next - now) > kFrictionChange * std::max(now, next)) ++changes;
+            mFrictionDamping[i] = next;
         }
     }
     const double t1 = t + h;
@@ -543,7 +553,35 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             ++changes;
         }
     }
+    syncFriction(v0, true);
     return changes;
+}
+
+// Sliding friction in the implicit system: A_ii += c P and b_i −= c P (v₀ − v_s), P = I − nnᵀ,
+// so that (A + cP) Δv = b − c P (v₀ − v_s) puts the friction impulse −c P (v₁ − v_s) on the
+// vertex (updateContacts). What an earlier call added is taken out first.
+void Body::syncFriction(const VecX& v0, bool keep) {
+    for (size_t i = 0; i < vertexCount(); ++i) {
+        const double was = mFrictionInA[i];
+        const double c = keep && mContactCollider[i] >= 0 && mConstraints.kind[i] == 2
+                             ? mFrictionDamping[i]
+                             : 0.0;
+        if (was == 0.0 && c == 0.0) continue;
+        const int slot = mA.diagonalSlot(static_cast<int>(i));
+        if (was != 0.0) {
+            const Vec3 a = vec3At(mFrictionAxis.data(), i);
+            mA.addBlock(slot, Mat3(Mat3::Identity() - a * a.transpose()), -was);
+        }
+        mFrictionInA[i] = c;
+        Eigen::Map<Vec3> rhs(mFriction.data() + 3 * i);
+        rhs.setZero();
+        if (c == 0.0) continue;
+        const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+        const Mat3 tangential = Mat3::Identity() - nrm * nrm.transpose();
+        vec3At(mFrictionAxis.data(), i) = nrm;
+        mA.addBlock(slot, tangential, c);
+        rhs = -c * (tangential * (vec3At(v0.data(), i) - vec3At(mContactVelocity.data(), i)));
+    }
 }
 
 int Body::resolveContacts(const Environment& env, double h, SubstepStatus& st) {
@@ -1154,6 +1192,7 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             ls.residual = std::max(ls.residual, res);
             ++st.contactSolves;
         }
+        syncFriction(v0, false); // A as assembled again (Newton, the next rounds' callers)
     }
     for (size_t i = 0; i < n; ++i)
         if (mContactCollider[i] >= 0) ++st.contactConstraints;

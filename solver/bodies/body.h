@@ -71,7 +71,7 @@ struct StepOptions {
     // BlockMultigrid::Settings::smoothedMinRows block rows up (its set-up pays only there,
     // bench/README.md) and plain aggregation below; Plain and Smoothed force one.
     MultigridKind multigrid = MultigridKind::Automatic;
-    double cgTolerance = 1e-3;     // relative residual of the filtered system
+    double cgTolerance = 1e-3; // relative residual of the filtered system
     int cgMaxIterations = 2000;
     // Newton on the backward-Euler residual after the linearised solve (body.cpp, newton()):
     // at most `newtonIterations` corrections, until every free vertex's velocity residual
@@ -312,9 +312,12 @@ private:
                     double thick, double t1, double h, const VecX& x0, const VecX& v0,
                     const Vec3& path, bool stick);
     void contactRhs(double h);
+    // The sliding contacts' implicit friction (updateContacts) into A's diagonal blocks and its
+    // surface-velocity part into mFriction; `keep` false takes it out of A again.
+    void syncFriction(const VecX& v0, bool keep);
     void landed();
-    int updateContacts(const Environment& env, double t, double h, const VecX& x0,
-                       const VecX& v0, SubstepStatus& st);
+    int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
+                       SubstepStatus& st);
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
     void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
                   bool withMatrix = true);
@@ -341,13 +344,13 @@ private:
     double mNewtonCgTolerance = 0.0; // Environment::retryCgTolerance while a retry runs
     bool mNewtonKeepCoarse = false;  // Environment::retryKeepCoarse while a retry runs
 
-    StepKinematics mKin; // the substep's scripted motion (evaluateKinematics)
+    StepKinematics mKin;      // the substep's scripted motion (evaluateKinematics)
     std::vector<int> mPinned; // vertex per pin
     std::vector<int> mPinSet; // index into mPinSets per pin
     std::vector<PinSet> mPinSets;
     std::vector<std::shared_ptr<const SurfaceBinding>>
-        mPinBinding;            // per pin: its attachment, or null
-    VecX mAnchor;               // 3 per pin: initial position
+        mPinBinding; // per pin: its attachment, or null
+    VecX mAnchor;    // 3 per pin: initial position
     // Soft attachments (PinSet::stiffness > 0): free vertices pulled to their bound points.
     struct SoftAttachment {
         int vertex;
@@ -369,12 +372,15 @@ private:
     std::vector<uint8_t> mTouching;      // per vertex: touching a collider after the substep
     std::vector<double> mContactSpeed;   // per vertex: the surface's normal speed (m/s)
     std::vector<double> mContactMu;      // per vertex: the holding collider's friction μ
-    VecX mFriction;        // 3 per vertex: a sliding contact's friction impulse (N·s), in b
+    VecX mFriction;        // 3 per vertex: a sliding contact's friction term in b (N·s)
     VecX mContactVelocity; // 3 per vertex: the surface velocity at the contact (m/s)
     VecX mStickVelocity;   // 3 per vertex: a sticking contact's velocity over the step (m/s)
-    std::vector<uint8_t> mReleased;      // per vertex: contact released in this substep
-    std::vector<uint8_t> mFoundInside;   // per vertex: its contact came from ending inside
-    std::vector<double> mFrictionCap;    // per vertex: the most friction a slide may get (N·s)
+    std::vector<uint8_t> mReleased;       // per vertex: contact released in this substep
+    std::vector<uint8_t> mFoundInside;    // per vertex: its contact came from ending inside
+    std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)
+    std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
+    std::vector<double> mFrictionInA;     // per vertex: the c now added to A (kg) ...
+    VecX mFrictionAxis;                   // ... about this normal (3 per vertex)
     VecX mYPos; // 3 per vertex: the position alteration y of the contacts (x₁ = x₀ + h v₁ + y)
     VecX mBc, mTmp; // the right-hand side with y's term; scratch
     VecX mWind, mF, mKv, mDv, mDvGuess, mB, mG, mF0, mFel, mGk, mZero;
