@@ -484,8 +484,8 @@ def cape(V, T):
     return P, np.array(F), collar
 
 
-def ponytail(V, T, strands=30, segments=16, length=0.36):
-    """Roots on the back of the head round (0, 1.73, back), ROOT_OFFSET off the skin, combed
+def ponytail(V, T, strands=30, segments=16, length=0.36, root_offset=ROOT_OFFSET):
+    """Roots on the back of the head round (0, 1.73, back), root_offset off the skin, combed
     back over the first third and then hanging down behind the neck onto the cape."""
     pts = []
     for s in range(strands):
@@ -497,7 +497,7 @@ def ponytail(V, T, strands=30, segments=16, length=0.36):
     d, q = closest_points(seeds, V, T)
     n = seeds - q
     n /= np.linalg.norm(n, axis=1, keepdims=True)
-    roots = q + ROOT_OFFSET * n
+    roots = q + root_offset * n
     out = []
     step = length / segments
     for s in range(strands):
@@ -517,6 +517,15 @@ def ponytail(V, T, strands=30, segments=16, length=0.36):
 
 
 def main(argv):
+    # --root-offset M: the ponytail's roots M metres off the scalp (tests: roots within the body
+    # collider's 1 cm thickness, as a groom rooted on the skin has them).
+    root_offset = ROOT_OFFSET
+    if "--root-offset" in argv:
+        k = argv.index("--root-offset")
+        if k + 1 >= len(argv):
+            sys.exit("make_character.py: --root-offset needs a distance in metres")
+        root_offset = float(argv[k + 1])
+        argv = argv[:k] + argv[k + 2:]
     folder = argv[0] if argv else "body"
     V, W, T = build_skin()
     if not check_closed(T):
@@ -530,7 +539,7 @@ def main(argv):
     P, CF, collar = cape(V, T)
     write_obj("cape.obj", P, CF, "examples/11_character/make_character.py: the cape on the rest pose, "
               "row 0 (vertices 0-%d) is the collar" % CAPE_COLS)
-    strands = ponytail(V, T)
+    strands = ponytail(V, T, root_offset=root_offset)
     with open("hair.csv", "w") as f:
         f.write("x,y,z,strand\n")
         for s, line in enumerate(strands):

@@ -18,6 +18,15 @@
 // with the point's mass infinite: Σ w_k Δx_k = −s n₁, the interpolated point moves exactly s.
 // The velocity change Δu of the interpolated point (u = Σ w_k v_k − ṗ, the same approach and
 // friction rule as above along −n₁) is split the same way, Δv_k = (w_k / Σ w_j²) Δu.
+// A pinned vertex within the thickness (a hair root on the scalp, a collar sewn closer than ξ)
+// cannot be moved out, so an edge or triangle carrying it is held off by its clearance c_p (the
+// least distance to the body at the step's ends) instead: ξ_e = min(ξ, c_p) in the CCD (ξ_e/2)
+// and the response, and the clearance asked of the point met keeps the pinned vertices' own
+// shortfalls, by weight:
+//   ξ' = ξ_e − Σ_{k pinned} w_k max(0, ξ_e − g_k),   g_k the pinned vertex's clearance along n;
+// with one movable vertex m the shortfall is then w_m (ξ_e − g_m) and m moves by at most ξ_e,
+// not by (ξ − g)/w_m, unbounded as the point met nears the pin (a root segment thrown 6 m; at
+// ξ on a root on the scalp, the next vertex pushed sideways by ξ a pass, its segments 1.45×).
 #include "solver/collider/moving_collider.h"
 
 #include "solver/collider/collider.h"
@@ -262,6 +271,28 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
         return vs;
     };
     auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
+    // Pinned vertices within the thickness (a hair root on the scalp, a collar sewn closer than
+    // ξ): their clearance over the step, the most an edge or triangle they carry can be held off.
+    std::vector<double> pinClear;
+    auto clearanceOf = [&](int v) {
+        if (movable[v]) return thickness;
+        if (pinClear.empty()) pinClear.assign(n, -1.0);
+        double& c = pinClear[v];
+        if (c < 0.0) {
+            c = thickness;
+            ContactPoint cp;
+            if (closest(vec3At(x0.data(), v), false, thickness, cp)) c = std::min(c, cp.distance);
+            if (closest(vec3At(x1.data(), v), true, thickness, cp)) c = std::min(c, cp.distance);
+            c = std::max(c, 1e-3 * thickness); // on the surface: only crossing is caught
+        }
+        return c;
+    };
+    // The CCD options and the distance a hit is placed at, for a primitive held off by xi.
+    auto optionsFor = [&](double xi) {
+        contact::CcdOptions o = opt;
+        o.thickness = 0.5 * xi;
+        return o;
+    };
     for (int pass = 0; pass < passes; ++pass) {
         int hits = 0;
         // Vertices against triangles.
@@ -330,6 +361,9 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
         for (const auto& e : edges) {
             const int i = e[0], j = e[1];
             if (!movable[i] && !movable[j]) continue;
+            const double xiE = std::min(clearanceOf(i), clearanceOf(j));
+            const contact::CcdOptions optE = xiE < thickness ? optionsFor(xiE) : opt;
+            const double wantE = xiE < thickness ? xiE * (1.0 + 1e-6) + 1e-9 : want;
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
             if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
@@ -360,10 +394,10 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 if (clearAtFirstAdvance(s0, s1, 2,
                                         boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0),
                                                s0[2].cwiseMin(s0[3]), s0[2].cwiseMax(s0[3])),
-                                        opt))
+                                        optE))
                     continue;
                 if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
-                                         corner(false, s), corner(true, s), opt, toi) &&
+                                         corner(false, s), corner(true, s), optE, toi) &&
                     toi < first) {
                     first = toi;
                     hitEdge = k;
@@ -386,13 +420,18 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 Eigen::Map<Vec3> xa(x1.data() + 3 * i), xb(x1.data() + 3 * j);
                 const Vec3 cloth1 = xa + sa * (xb - xa);
                 const double gap = (cloth1 - body1).dot(nn);
-                if (gap < want) {
+                // A pinned end within the thickness keeps its own shortfall (ξ' above).
+                const double wantHere =
+                    wantE -
+                    (movable[i] ? 0.0 : (1.0 - sa) * std::max(0.0, wantE - (xa - body1).dot(nn))) -
+                    (movable[j] ? 0.0 : sa * std::max(0.0, wantE - (xb - body1).dot(nn)));
+                if (gap < wantHere) {
                     // Move the cloth point by (want − gap) n: the edge's vertices by their
                     // weights, scaled so the interpolated point moves exactly that far.
                     const double wa = movable[i] ? 1.0 - sa : 0.0, wb = movable[j] ? sa : 0.0;
                     const double norm = wa * (1.0 - sa) + wb * sa;
                     if (norm > 1e-12) {
-                        const Vec3 d = ((want - gap) / norm) * nn;
+                        const Vec3 d = ((wantHere - gap) / norm) * nn;
                         xa += wa * d;
                         xb += wb * d;
                     }
@@ -421,6 +460,10 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 finite = finite && c0[k].allFinite() && c1[k].allFinite();
             }
             if (!finite) continue; // left to the trouble detector
+            const double xiT =
+                std::min({clearanceOf(tv[0]), clearanceOf(tv[1]), clearanceOf(tv[2])});
+            const contact::CcdOptions optT = xiT < thickness ? optionsFor(xiT) : opt;
+            const double wantT = xiT < thickness ? xiT * (1.0 + 1e-6) + 1e-9 : want;
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
             for (int k = 0; k < 3; ++k) {
@@ -445,10 +488,10 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 const Vec3 p0 = corner(false, b), p1 = corner(true, b);
                 const Vec3 s0[4] = {p0, c0[0], c0[1], c0[2]};
                 const Vec3 s1[4] = {p1, c1[0], c1[1], c1[2]};
-                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
+                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), optT)) continue;
                 double toi;
                 if (contact::vertexTriangleCcd(p0, p1, c0[0], c1[0], c0[1], c1[1], c0[2], c1[2],
-                                               opt, toi) &&
+                                               optT, toi) &&
                     toi < first) {
                     first = toi;
                     hitVertex = b;
@@ -493,8 +536,13 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 } else {
                     const Vec3 cloth1 = w[0] * c1[0] + w[1] * c1[1] + w[2] * c1[2];
                     const double gap = (p1 - cloth1).dot(n1);
-                    if (gap < want) {
-                        const Vec3 d = (-(want - gap) / norm) * n1;
+                    // Pinned corners within the thickness keep their own clearance (as above).
+                    double wantHere = wantT;
+                    for (int k = 0; k < 3; ++k)
+                        if (!movable[tv[k]])
+                            wantHere -= w[k] * std::max(0.0, wantT - (p1 - c1[k]).dot(n1));
+                    if (gap < wantHere) {
+                        const Vec3 d = (-(wantHere - gap) / norm) * n1;
                         for (int k = 0; k < 3; ++k) vec3At(x1.data(), tv[k]) += wm[k] * d;
                     }
                     // The velocity of the cloth point relative to the body vertex's, along the

@@ -348,3 +348,44 @@ TEST_CASE("moving mesh: a 1 cm rod at 2 m/s does not pass through a sheet of 2.5
                 if (mu == 0.0) CHECK(o.lastStretch < 1.1);
             }
 }
+
+// Hair roots pinned within the collider's thickness (moving_collider.cpp, ξ_e): the root
+// segment is held off the body by the root's own clearance, so nothing throws its free end.
+// 1. The root 0.55 ξ over a box's ridge that rises 0.1 ξ in the step (a skinned scalp under a
+//    root 5 mm off it, ξ = 1 cm, as in examples/11_character with the roots lowered), the segment
+//    2 cm out over the ridge and slightly down, its point nearest the ridge ~4 % along it: held
+//    off by ξ at the point met (before), the free end was thrown by shortfall / weight = 0.16 m
+//    (6 m in the character). 2. The root on the top face, the box sliding 2 mm under it: its
+//    edges pass through the root; the free end (2 cm up) is not pushed (before: up to ξ a pass,
+//    sideways; the character's root segments 1.45× their rest length).
+TEST_CASE("moving mesh: a root pinned within the thickness does not throw its segment",
+          "[collider][moving]") {
+    const double xi = 0.01, h = 1.0 / 24.0;
+    const Solid s = box(0.1, 0.05, 0.1); // the ridge along x at y = 0.05, z = 0.1
+    const std::vector<uint8_t> movable = {0, 1};
+    SECTION("a ridge rising under a root 0.55 ξ above it") {
+        MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(0, 0.1 * xi / h, 0), 3, 24.0));
+        m.prepare(0.0, h, xi);
+        VecX x0(6);
+        x0 << 0.0, 0.05 + 0.55 * xi, 0.0998, 0.0, 0.05 + 0.55 * xi - 0.002, 0.1198;
+        VecX x1 = x0, v1 = VecX::Zero(6);
+        m.sweep(x0, x1, v1, movable, {{0, 1}}, {}, xi, 0.0, h);
+        CHECK((x1.segment<3>(0) - x0.segment<3>(0)).norm() == 0.0);
+        // At most the root's clearance at the end (0.45 ξ): nothing needs moving at all here.
+        CHECK((x1.segment<3>(3) - x0.segment<3>(3)).norm() <= 0.45 * xi);
+        CHECK(v1.allFinite());
+        // Still above the ridge (y = 0.05 + 0.1 ξ at the end) where it passes over it.
+        const double sRidge = (0.1 - x1[2]) / (x1[5] - x1[2]);
+        CHECK(x1[1] + sRidge * (x1[4] - x1[1]) > 0.05 + 0.1 * xi);
+    }
+    SECTION("a box sliding under a root on its face") {
+        MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(0.002 / h, 0, 0), 3, 24.0));
+        m.prepare(0.0, h, xi);
+        VecX x0(6);
+        x0 << 0.001, 0.05, 0.0, 0.006, 0.07, 0.0; // the root on the diagonal's path
+        VecX x1 = x0, v1 = VecX::Zero(6);
+        m.sweep(x0, x1, v1, movable, {{0, 1}}, {}, xi, 0.0, h);
+        CHECK((x1.segment<3>(0) - x0.segment<3>(0)).norm() == 0.0);
+        CHECK((x1.segment<3>(3) - x0.segment<3>(3)).norm() <= 1e-3 * xi);
+    }
+}
