@@ -50,9 +50,11 @@ SliceOverlays sceneOverlays(const fields::Scene& scene, double t) {
         o.windicator.speed = w.speed.scalarAt(t);
     }
     TimelineOverlay& tl = o.timeline;
-    const double fps = scene.settings.fps > 0 ? scene.settings.fps : 24.0;
-    tl.sceneStart = scene.settings.frameStart / fps;
-    tl.sceneEnd = scene.settings.frameEnd / fps;
+    // Shot time, as $t and the keys see it (scene.time_zero: frames 1001-1048 are 0-1.96 s).
+    fields::SceneSettings st = scene.settings;
+    if (!(st.fps > 0)) st.fps = 24.0;
+    tl.sceneStart = st.frameTime(st.frameStart);
+    tl.sceneEnd = st.frameTime(st.frameEnd);
     tl.t0 = std::min({tl.sceneStart, t, 0.0});
     tl.t1 = std::max(tl.sceneEnd, t);
     for (size_t i = 0; i < scene.gusts.size(); ++i) {
@@ -98,7 +100,8 @@ void parseObjGeometry(std::istream& in, GeometryOverlay& out) {
         } else if (tag == "f") {
             std::vector<int> poly;
             for (std::string w; words >> w;) poly.push_back(index(w));
-            for (size_t k = 1; k + 1 < poly.size(); ++k) out.triangles.push_back({poly[0], poly[k], poly[k + 1]});
+            for (size_t k = 1; k + 1 < poly.size(); ++k)
+                out.triangles.push_back({poly[0], poly[k], poly[k + 1]});
         } else if (tag == "l") {
             std::vector<int> line;
             for (std::string w; words >> w;) line.push_back(index(w));
@@ -130,12 +133,14 @@ bool loadFrameGeometry(const std::string& path, GeometryOverlay& out, std::strin
         error = path + ": no x, y, z columns";
         return false;
     }
-    for (size_t i = 0; i < ps.size(); ++i) out.points.push_back({ps.columns[x][i], ps.columns[y][i], ps.columns[z][i]});
+    for (size_t i = 0; i < ps.size(); ++i)
+        out.points.push_back({ps.columns[x][i], ps.columns[y][i], ps.columns[z][i]});
     for (const std::vector<int>& f : ps.faces)
         for (size_t k = 1; k + 1 < f.size(); ++k) out.triangles.push_back({f[0], f[k], f[k + 1]});
     if (strand >= 0)
         for (size_t i = 0; i < ps.size(); ++i) {
-            if (i == 0 || ps.columns[strand][i] != ps.columns[strand][i - 1]) out.polylines.emplace_back();
+            if (i == 0 || ps.columns[strand][i] != ps.columns[strand][i - 1])
+                out.polylines.emplace_back();
             out.polylines.back().push_back(static_cast<int>(i));
         }
     return true;
