@@ -151,7 +151,8 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     mTmp2 = x;
     for (int i : mConstrained) {
         Eigen::Map<Vec3> t(mTmp2.data() + 3 * i);
-        if (c.kind[i] == 1) t.setZero();
+        if (c.kind[i] == 1)
+            t.setZero();
         else {
             const Vec3 n = vec3At(c.normal.data(), i);
             t -= n.dot(t) * n;
@@ -161,7 +162,8 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     for (int i : mConstrained) {
         Eigen::Map<Vec3> o(out.data() + 3 * i);
         const Eigen::Map<const Vec3> xi(x.data() + 3 * i);
-        if (c.kind[i] == 1) o = xi;
+        if (c.kind[i] == 1)
+            o = xi;
         else {
             const Vec3 n = vec3At(c.normal.data(), i);
             o -= n.dot(o) * n;
@@ -170,8 +172,9 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     }
 }
 
-SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
-                                  LinearSolverKind kind, double tolerance, int maxIterations) {
+SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b,
+                                  VecX& dv, LinearSolverKind kind, double tolerance,
+                                  int maxIterations) {
     const int n3 = 3 * A.size();
     if (dv.size() != n3) dv = VecX::Zero(n3);
     mConstrained.clear();
@@ -303,8 +306,8 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
 
 // Multigrid-preconditioned CG iterations on Â y = rhs from the residual in mR (‖mR‖ = rNorm)
 // until ‖r‖ ≤ target or `it` reaches maxIterations; returns ‖r‖ (of the products used).
-double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
-                                   SolveStatus& st) {
+double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool single,
+                                   int maxIterations, int& it, SolveStatus& st) {
     if (rNorm <= target || !std::isfinite(rNorm)) return rNorm;
     const size_t n3 = static_cast<size_t>(y.size());
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
@@ -380,8 +383,10 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     const double target = tolerance * rhsNorm;
     // r = rhs − Â y (the products in double unless `single`); returns ‖r‖.
     auto residual = [&](bool single) {
-        if (single) mMultigrid.multiplyDot(y.data(), mQ.data(), true);
-        else mMultigrid.multiply(y.data(), mQ.data());
+        if (single)
+            mMultigrid.multiplyDot(y.data(), mQ.data(), true);
+        else
+            mMultigrid.multiply(y.data(), mQ.data());
         mR = rhs - mQ;
         return std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
     };
@@ -407,7 +412,10 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
     SolveStatus st;
     // The scalar matrix (its pattern built once), then the constrained block rows and columns
     // filtered.
-    if (mFilteredA.rows() != 3 * A.size() || mFilteredA.nonZeros() != 9L * A.slotCount()) mLdlt.reset();
+    if (mFilteredA.rows() != 3 * A.size() || mFilteredA.nonZeros() != 9L * A.slotCount()) {
+        mLdlt.reset();
+        mLdltBanded.reset();
+    }
     A.toScalar(mFilteredA);
     const bool constrained = !c.kind.empty() && c.any();
     if (constrained) {
@@ -435,22 +443,43 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
             }
         }
     }
-    if (!mLdlt) {
-        mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
-        mLdlt->analyzePattern(mFilteredA);
+    if (!mLdlt && !mLdltBanded) {
+        // Natural order when the block pattern is a band at most kBandedOrder blocks wide.
+        constexpr int kBandedOrder = 4;
+        int band = 0;
+        for (int i = 0; i < A.size(); ++i)
+            for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
+                band = std::max(band, std::abs(A.blockCols()[k] - i));
+        if (band <= kBandedOrder) {
+            mLdltBanded = std::make_unique<
+                Eigen::SimplicialLDLT<ColMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>>>();
+            mLdltBanded->analyzePattern(mFilteredA);
+        } else {
+            mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
+            mLdlt->analyzePattern(mFilteredA);
+        }
     }
-    mLdlt->factorize(mFilteredA);
-    if (mLdlt->info() != Eigen::Success) {
+    bool ok;
+    if (mLdltBanded) {
+        mLdltBanded->factorize(mFilteredA);
+        ok = mLdltBanded->info() == Eigen::Success;
+        if (ok) y = mLdltBanded->solve(rhs);
+    } else {
+        mLdlt->factorize(mFilteredA);
+        ok = mLdlt->info() == Eigen::Success;
+        if (ok) y = mLdlt->solve(rhs);
+    }
+    if (!ok) {
         st.failed = true;
         return st;
     }
-    y = mLdlt->solve(rhs);
     st.iterations = 1;
     mQ.resize(rhs.size());
     applyFiltered(A, c, y, mQ);
     const double rn = std::sqrt(deterministicDot(rhs.data(), rhs.data(), rhs.size()));
     const VecX res = mQ - rhs;
-    st.residual = rn > 0.0 ? std::sqrt(deterministicDot(res.data(), res.data(), res.size())) / rn : 0.0;
+    st.residual =
+        rn > 0.0 ? std::sqrt(deterministicDot(res.data(), res.data(), res.size())) / rn : 0.0;
     st.converged = std::isfinite(st.residual);
     st.failed = !st.converged;
     return st;

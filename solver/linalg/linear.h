@@ -50,8 +50,12 @@ public:
         p[4] += value;
         p[8] += value;
     }
-    Mat3 block(int slot) const { return Eigen::Map<const Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)); }
-    void setBlock(int slot, const Mat3& b) { Eigen::Map<Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)) = b; }
+    Mat3 block(int slot) const {
+        return Eigen::Map<const Mat3>(mVal.data() + 9 * static_cast<size_t>(slot));
+    }
+    void setBlock(int slot, const Mat3& b) {
+        Eigen::Map<Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)) = b;
+    }
     // 9 × slotCount() values (+ kBsrPad zeros).
     const double* values() const { return mVal.data(); }
 
@@ -62,7 +66,9 @@ public:
     // sorted; slot k is the k-th entry of blockCols().
     const std::vector<int>& blockRowStart() const { return mBlockRowStart; }
     const std::vector<int>& blockCols() const { return mBlockCols; }
-    BsrPattern pattern() const { return {mBlockRowStart.data(), mBlockCols.data(), mDiagSlot.data(), mN}; }
+    BsrPattern pattern() const {
+        return {mBlockRowStart.data(), mBlockCols.data(), mDiagSlot.data(), mN};
+    }
 
     // The scalar (3n × 3n) matrix; `toScalar` reuses out's pattern when it already has it.
     void toScalar(ScalarMatrix& out) const;
@@ -83,7 +89,7 @@ private:
 // prescribed change in the constrained directions. Free: S = I; Full (a pin): S = 0;
 // Plane (a contact, normal n): S = I − n nᵀ.
 struct Constraints {
-    std::vector<uint8_t> kind; // 0 free, 1 full, 2 plane
+    std::vector<uint8_t> kind;  // 0 free, 1 full, 2 plane
     std::vector<double> normal; // 3 per vertex (kind 2)
     std::vector<double> z;      // 3 per vertex: prescribed velocity change (m/s)
 
@@ -134,10 +140,10 @@ public:
 private:
     SolveStatus solvePcg(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
                          double tolerance, int maxIterations);
-    SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
-                                  double tolerance, int maxIterations);
-    double multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
-                       SolveStatus& st);
+    SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
+                                  VecX& y, double tolerance, int maxIterations);
+    double multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations,
+                       int& it, SolveStatus& st);
     SolveStatus solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y);
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
@@ -151,7 +157,12 @@ private:
     std::vector<Mat3> mPrecond;
     using ColMatrix = BlockMatrix::ScalarMatrix;
     ColMatrix mFilteredA;
-    std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix>> mLdlt;
+    std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix>> mLdlt; // fill-reducing (AMD) order
+    // A banded matrix (hair: each vertex coupled to its strand's next two) in its own order: no
+    // fill outside the band, and no permuted copy of the matrix per factorisation (Eigen's AMD
+    // path copies it, permute_symm_to_symm: 8 % of examples/10_hair_turn's time).
+    std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>>>
+        mLdltBanded;
 };
 
 } // namespace gale::solver
