@@ -151,8 +151,7 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     mTmp2 = x;
     for (int i : mConstrained) {
         Eigen::Map<Vec3> t(mTmp2.data() + 3 * i);
-        if (c.kind[i] == 1)
-            t.setZero();
+        if (c.kind[i] == 1) t.setZero();
         else {
             const Vec3 n = vec3At(c.normal.data(), i);
             t -= n.dot(t) * n;
@@ -162,8 +161,7 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     for (int i : mConstrained) {
         Eigen::Map<Vec3> o(out.data() + 3 * i);
         const Eigen::Map<const Vec3> xi(x.data() + 3 * i);
-        if (c.kind[i] == 1)
-            o = xi;
+        if (c.kind[i] == 1) o = xi;
         else {
             const Vec3 n = vec3At(c.normal.data(), i);
             o -= n.dot(o) * n;
@@ -172,9 +170,8 @@ void FilteredSolver::applyFiltered(const BlockMatrix& A, const Constraints& c, c
     }
 }
 
-SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b,
-                                  VecX& dv, LinearSolverKind kind, double tolerance,
-                                  int maxIterations) {
+SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
+                                  LinearSolverKind kind, double tolerance, int maxIterations) {
     const int n3 = 3 * A.size();
     if (dv.size() != n3) dv = VecX::Zero(n3);
     mConstrained.clear();
@@ -306,8 +303,8 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
 
 // Multigrid-preconditioned CG iterations on Â y = rhs from the residual in mR (‖mR‖ = rNorm)
 // until ‖r‖ ≤ target or `it` reaches maxIterations; returns ‖r‖ (of the products used).
-double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool single,
-                                   int maxIterations, int& it, SolveStatus& st) {
+double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
+                                   SolveStatus& st) {
     if (rNorm <= target || !std::isfinite(rNorm)) return rNorm;
     const size_t n3 = static_cast<size_t>(y.size());
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
@@ -383,10 +380,8 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     const double target = tolerance * rhsNorm;
     // r = rhs − Â y (the products in double unless `single`); returns ‖r‖.
     auto residual = [&](bool single) {
-        if (single)
-            mMultigrid.multiplyDot(y.data(), mQ.data(), true);
-        else
-            mMultigrid.multiply(y.data(), mQ.data());
+        if (single) mMultigrid.multiplyDot(y.data(), mQ.data(), true);
+        else mMultigrid.multiply(y.data(), mQ.data());
         mR = rhs - mQ;
         return std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
     };
@@ -478,8 +473,7 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
     applyFiltered(A, c, y, mQ);
     const double rn = std::sqrt(deterministicDot(rhs.data(), rhs.data(), rhs.size()));
     const VecX res = mQ - rhs;
-    st.residual =
-        rn > 0.0 ? std::sqrt(deterministicDot(res.data(), res.data(), res.size())) / rn : 0.0;
+    st.residual = rn > 0.0 ? std::sqrt(deterministicDot(res.data(), res.data(), res.size())) / rn : 0.0;
     st.converged = std::isfinite(st.residual);
     st.failed = !st.converged;
     return st;

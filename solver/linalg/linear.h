@@ -50,12 +50,8 @@ public:
         p[4] += value;
         p[8] += value;
     }
-    Mat3 block(int slot) const {
-        return Eigen::Map<const Mat3>(mVal.data() + 9 * static_cast<size_t>(slot));
-    }
-    void setBlock(int slot, const Mat3& b) {
-        Eigen::Map<Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)) = b;
-    }
+    Mat3 block(int slot) const { return Eigen::Map<const Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)); }
+    void setBlock(int slot, const Mat3& b) { Eigen::Map<Mat3>(mVal.data() + 9 * static_cast<size_t>(slot)) = b; }
     // 9 × slotCount() values (+ kBsrPad zeros).
     const double* values() const { return mVal.data(); }
 
@@ -66,9 +62,7 @@ public:
     // sorted; slot k is the k-th entry of blockCols().
     const std::vector<int>& blockRowStart() const { return mBlockRowStart; }
     const std::vector<int>& blockCols() const { return mBlockCols; }
-    BsrPattern pattern() const {
-        return {mBlockRowStart.data(), mBlockCols.data(), mDiagSlot.data(), mN};
-    }
+    BsrPattern pattern() const { return {mBlockRowStart.data(), mBlockCols.data(), mDiagSlot.data(), mN}; }
 
     // The scalar (3n × 3n) matrix; `toScalar` reuses out's pattern when it already has it.
     void toScalar(ScalarMatrix& out) const;
@@ -89,7 +83,7 @@ private:
 // prescribed change in the constrained directions. Free: S = I; Full (a pin): S = 0;
 // Plane (a contact, normal n): S = I − n nᵀ.
 struct Constraints {
-    std::vector<uint8_t> kind;  // 0 free, 1 full, 2 plane
+    std::vector<uint8_t> kind; // 0 free, 1 full, 2 plane
     std::vector<double> normal; // 3 per vertex (kind 2)
     std::vector<double> z;      // 3 per vertex: prescribed velocity change (m/s)
 
@@ -140,10 +134,10 @@ public:
 private:
     SolveStatus solvePcg(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
                          double tolerance, int maxIterations);
-    SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
-                                  VecX& y, double tolerance, int maxIterations);
-    double multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations,
-                       int& it, SolveStatus& st);
+    SolveStatus solvePcgMultigrid(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y,
+                                  double tolerance, int maxIterations);
+    double multigridCg(VecX& y, double rNorm, double target, bool single, int maxIterations, int& it,
+                       SolveStatus& st);
     SolveStatus solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs, VecX& y);
     void applyFiltered(const BlockMatrix& A, const Constraints& c, const VecX& x, VecX& out);
 
