@@ -333,6 +333,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     mStickVelocity.setZero(3 * n);
     mContactMu.assign(n, 0.0);
     mFoundInside.assign(n, 0);
+    mEndBound.assign(n * mKin.colliders.size(), -1.0);
+    mEndAt.resize(3 * static_cast<Eigen::Index>(mEndBound.size()));
     // A is assembled anew for the substep: no friction in it.
     mFrictionDamping.assign(n, 0.0);
     mFrictionPrev.assign(2 * n, 0.0);
@@ -411,6 +413,21 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             }
         }
     }
+}
+
+bool Body::endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp) {
+    const size_t slot = k * vertexCount() + i;
+    const bool known = slot < mEndBound.size() && mEndBound[slot] >= 0.0;
+    if (known && (x - vec3At(mEndAt.data(), slot)).norm() < mEndBound[slot] - beyond) return false;
+    const ColliderPose& pose = mKin.colliders[k].end;
+    cp = queryCollider(pose, x);
+    if (slot < mEndBound.size()) {
+        // A moving mesh reports nothing (∞) beyond its search radius: that radius is the bound.
+        mEndBound[slot] = std::isfinite(cp.distance) ? std::max(cp.distance, 0.0)
+                                                     : (pose.moving ? pose.searchRadius : -1.0);
+        vec3At(mEndAt.data(), slot) = x;
+    }
+    return true;
 }
 
 // The inelastic impact of the contacts that closed in during the step (setContact): the normal
@@ -542,7 +559,8 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
             const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
             const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
-            const ContactPoint cp = queryCollider(pose, x1);
+            ContactPoint cp;
+            if (!endPoseQuery(k, i, x1, thick - kContactSlop, cp)) continue;
             if (!(cp.distance < thick - kContactSlop)) continue;
             if (!((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
             setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, c.friction > 0.0);
@@ -598,8 +616,9 @@ int Body::resolveContacts(const Environment& env, double h, SubstepStatus& st) {
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1 && mContactCollider[i] < 0) continue; // pin or held
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
-            const ContactPoint cp = queryCollider(pose, x);
             const bool held = mContactCollider[i] == static_cast<int>(ci);
+            ContactPoint cp;
+            if (!endPoseQuery(ci, i, x, held ? INFINITY : thick, cp)) continue;
             if (!std::isfinite(cp.distance)) continue; // a moving mesh found nothing near
             if (!(cp.distance < thick) && !held) continue;
             touched[i] = 1;

@@ -319,6 +319,9 @@ private:
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
+    // The closest point of collider k's end pose to vertex i at x, unless the vertex is known to
+    // be farther than `beyond` from it (mEndBound): then false, without a query.
+    bool endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp);
     void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
                   bool withMatrix = true);
     // The filtered backward-Euler residual g at Δv into mG (mX, mV, mF, and A when asked, left
@@ -377,6 +380,11 @@ private:
     VecX mStickVelocity;   // 3 per vertex: a sticking contact's velocity over the step (m/s)
     std::vector<uint8_t> mReleased;       // per vertex: contact released in this substep
     std::vector<uint8_t> mFoundInside;    // per vertex: its contact came from ending inside
+    // Per collider and vertex, within a substep: a lower bound (m) on the distance to the
+    // collider's end pose, known at position mEndAt (the distance is 1-Lipschitz in x, so a
+    // vertex that moved less than bound − ξ since cannot be within ξ: endPoseFar()); −1 unknown.
+    std::vector<double> mEndBound;
+    VecX mEndAt;
     std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)
     std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
     std::vector<double> mFrictionInA;     // per vertex: the c now added to A (kg) ...
