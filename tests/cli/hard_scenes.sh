@@ -4,7 +4,8 @@
 # hair attached to them; self-collision on a third of the cloth) simulated two at a time. Every
 # run exits 0 — trouble is recovered (halved substeps, at the smallest one strain limiting) and
 # reported in run.json, never a give-up (exit 4), a signal or another code — and no frame
-# written holds a NaN or an infinity. GALE_HARD_SEED=N runs one other set.
+# written holds a NaN or an infinity. GALE_HARD_SEED=N runs one other set. Each scene's largest
+# stretch and energy are reported (hard_scenes_report.py).
 source "$(dirname "$0")/lib.bash" "$@"
 
 SEEDS=${GALE_HARD_SEED:-20261122 7 8}
@@ -83,5 +84,11 @@ done
 unresolved=$(cat out/*/run.json 2> /dev/null | grep -o '"unresolved": [0-9]*' | awk '{ n += $2 } END { print n + 0 }')
 intersecting=$(cat out/*/run.json 2> /dev/null | grep -o '"self_intersections": [0-9]*' | awk '{ n += $2 } END { print n + 0 }')
 echo "hard_scenes: self-collision in $selfc scenes: $unresolved pair(s) left unresolved, $intersecting intersecting pair-frames" >&2
+# Every scene's largest stretch and energy (run.json), worst first, with what forced it: reported,
+# not asserted (issue 25 asks none past 1.5x; see the closing notes for where that stands).
+PY=$(test -x /usr/bin/python3 && echo /usr/bin/python3 || command -v python3)
+if [ -n "$PY" ]; then
+    "$PY" "$SRC/tests/cli/hard_scenes_report.py" out --top 15 | sed 's/^/hard_scenes: /' >&2
+fi
 echo "hard_scenes: seeds $SEED ($moving with moving bodies, $attached attached): $ok of $COUNT ran to the end (exit 0), $reported gave up (exit 4) in ${seconds}s on 2 workers" >&2
 finish
