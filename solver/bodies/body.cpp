@@ -36,6 +36,9 @@ constexpr double kFrictionChange = 0.01;
 // stick (IPC's ε_v, Li et al. 2020 §5: the friction force μ λ_n v_t / max(|v_t|, ε_v)); a
 // contact sliding slower creeps at most this fast under Coulomb's full force.
 constexpr double kSlipFloor = 1e-3;
+// The PCG residual's absolute floor, as a fraction of the CG tolerance of gravity's impulse over
+// the step (substep(), FilteredSolver::setResidualFloor).
+constexpr double kResidualFloor = 0.1;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
 } // namespace
@@ -740,7 +743,8 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
     VecX sb = b;
     mConstraints.apply(sb.data());
     rhs = sb - rhs;
-    const double target = mOptions.cgTolerance * std::sqrt(dot(rhs, rhs));
+    const double target =
+        std::max(mOptions.cgTolerance * std::sqrt(dot(rhs, rhs)), mResidualFloor);
     VecX y = dv - z;
     const double precTolerance = std::max(mOptions.cgTolerance, 1e-2);
     std::vector<VecX> V(kGmresRestart + 1), Z(kGmresRestart);
@@ -767,8 +771,10 @@ SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
         for (int j = 0; j < kGmresRestart; ++j) {
             Z[j].setZero(n3);
             mSolver.setKeepCoarse(true); // the same matrix as the solve above
+            mSolver.setResidualFloor(0.0); // V[j] is a unit vector: relative only
             const SolveStatus ps = mSolver.solve(mA, mZeroZ, V[j], Z[j], mOptions.linearSolver,
                                                  precTolerance, mOptions.cgMaxIterations);
+            mSolver.setResidualFloor(mResidualFloor);
             mSolver.setKeepCoarse(false);
             ls.iterations += ps.iterations;
             if (ps.failed || !Z[j].allFinite()) {
@@ -1194,6 +1200,16 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         else
             mDv.setZero(3 * n);
         mSolver.setPreconditioner(mOptions.preconditioner);
+        // The residual need not go below a tenth of the CG tolerance of gravity's impulse over
+        // the step, ‖M g‖ h (N·s; a velocity error of ~tol g h / 10, 4e-5 m/s at 1/24 s): at
+        // rest (a sheet lying on a collider: its filtered rhs is round-off) a relative
+        // tolerance alone chased noise for ~400 CG iterations a step at 64², ~80 with the
+        // floor (bench/README.md, "Collider contact in the solve").
+        double m2 = 0.0;
+        for (double m : mMass) m2 += m * m;
+        mResidualFloor =
+            kResidualFloor * mOptions.cgTolerance * std::sqrt(m2) * env.gravity.norm() * h;
+        mSolver.setResidualFloor(mResidualFloor);
         mSolver.multigrid().setKind(mOptions.multigrid);
         // The multigrid's near-null space: rigid-body modes about the substep's start positions.
         mSolver.multigrid().setPositions(x0.data(), static_cast<int>(n));

@@ -369,6 +369,7 @@ private:
     std::vector<double> mEdgeRest;
     BlockMatrix mA;
     FilteredSolver mSolver;
+    double mResidualFloor = 0.0; // N·s: the substep's absolute floor of the PCG residual
     Constraints mConstraints;
     std::vector<double> mContactImpulse; // per vertex: suppressed normal speed (m/s)
     std::vector<int> mContactCollider;   // per vertex: collider holding it in the solve, or -1

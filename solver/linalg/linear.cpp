@@ -234,7 +234,7 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
     applyFiltered(A, c, y, mQ);
     mR = rhs - mQ;
     double rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
-    const double target = tolerance * rhsNorm;
+    const double target = std::max(tolerance * rhsNorm, mResidualFloor);
     if (rNorm <= target) {
         st.converged = true;
         st.residual = rNorm / rhsNorm;
@@ -377,7 +377,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     mMultigrid.toLevelOrder(yNatural.data(), mYLevel.data());
     const VecX& rhs = mRhsLevel;
     VecX& y = mYLevel;
-    const double target = tolerance * rhsNorm;
+    const double target = std::max(tolerance * rhsNorm, mResidualFloor);
     // r = rhs − Â y (the products in double unless `single`); returns ‖r‖.
     auto residual = [&](bool single) {
         if (single) mMultigrid.multiplyDot(y.data(), mQ.data(), true);

@@ -127,6 +127,10 @@ public:
     // Multigrid only: the next solves refresh level 0 alone and keep the coarse levels
     // (BlockMultigrid::refresh's keepCoarse) — for solves with the same or a nearby matrix.
     void setKeepCoarse(bool keep) { mKeepCoarse = keep; }
+    // PCG stops at ‖r‖ ≤ max(tolerance ‖rhs‖, floor): an absolute floor (the rhs's units, N·s)
+    // below which the residual is physically nothing (Body: a tenth of the tolerance of
+    // gravity's impulse over the step). 0: relative only.
+    void setResidualFloor(double floor) { mResidualFloor = floor; }
 
     SolveStatus solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
                       LinearSolverKind kind, double tolerance, int maxIterations);
@@ -143,6 +147,7 @@ private:
 
     Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
     bool mKeepCoarse = false;
+    double mResidualFloor = 0.0;
     BlockMultigrid mMultigrid;
     VecX mTmp2, mR, mZ, mP, mQ;
     VecX mRhsLevel, mYLevel; // multigrid PCG's rhs and y in the multigrid's level-0 order
