@@ -54,14 +54,10 @@ int slotIn(const BsrMatrix& m, int i, int j) {
     return static_cast<int>(std::lower_bound(b, e, j) - m.cols.begin());
 }
 
-// diag and mirror of a pattern with sorted columns, symmetric, the diagonal present.
+// diag of a pattern with sorted columns, symmetric, the diagonal present.
 void finishPattern(BsrMatrix& m) {
     m.diag.resize(m.n);
-    m.mirror.resize(m.cols.size());
-    for (int i = 0; i < m.n; ++i) {
-        m.diag[i] = slotIn(m, i, i);
-        for (int k = m.start[i]; k < m.start[i + 1]; ++k) m.mirror[k] = slotIn(m, m.cols[k], i);
-    }
+    for (int i = 0; i < m.n; ++i) m.diag[i] = slotIn(m, i, i);
 }
 
 } // namespace
@@ -104,7 +100,7 @@ BlockMultigrid::Settings& BlockMultigrid::defaults() {
     return settings;
 }
 
-// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
+// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row order()[p]; its
 // slot k holds A's slot mSrcSlot[k]).
 void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     mLevels.assign(1, Level());
@@ -115,16 +111,15 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     const std::vector<int>& cols = A.blockCols();
     L.colouring =
         colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
-    mOrder = L.colouring.order;
     L.visit.resize(n);
-    for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
+    for (int p = 0; p < n; ++p) L.visit[order()[p]] = p;
     a.n = n;
     a.start.assign(n + 1, 0);
     a.cols.clear();
     mSrcSlot.clear();
     std::vector<std::pair<int, int>> row; // (level-0 column, A's slot)
     for (int p = 0; p < n; ++p) {
-        const int i = mOrder[p];
+        const int i = order()[p];
         row.clear();
         for (int k = start[i]; k < start[i + 1]; ++k) row.push_back({L.visit[cols[k]], k});
         std::sort(row.begin(), row.end());
@@ -397,10 +392,10 @@ void BlockMultigrid::levelZeroNullSpace(std::vector<double>& nullB) const {
             double radius = 0.0;
             if (m == 6) {
                 for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
-                    c += vec3At(mPositions.data(), mOrder[g.members[t]]);
+                    c += vec3At(mPositions.data(), order()[g.members[t]]);
                 c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
                 for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
-                    radius = std::max(radius, (vec3At(mPositions.data(), mOrder[g.members[t]]) - c).norm());
+                    radius = std::max(radius, (vec3At(mPositions.data(), order()[g.members[t]]) - c).norm());
             }
             const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
             for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
@@ -411,7 +406,7 @@ void BlockMultigrid::levelZeroNullSpace(std::vector<double>& nullB) const {
                 BlockMap translations(B);
                 translations = S;
                 if (m == 6) {
-                    const Vec3 p = inv * (vec3At(mPositions.data(), mOrder[i]) - c);
+                    const Vec3 p = inv * (vec3At(mPositions.data(), order()[i]) - c);
                     Mat3 cross;
                     cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
                     BlockMap(B + 9) = -S * cross;
@@ -485,14 +480,14 @@ size_t BlockMultigrid::bytes() const {
     size_t b = 0;
     auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
     for (const Level& L : mLevels) {
-        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.mirror), v(L.a.val), v(L.dinv);
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.val), v(L.dinv);
         v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
         v(L.dead), v(L.graphStart), v(L.graphCols), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
         v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot);
         v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
         v(L.r), v(L.x), v(L.t);
     }
-    v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
+    v(mPartial), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
     b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double); // and its factor
     return b;
 }
@@ -564,7 +559,8 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                 const Mat3 b = levelZeroBlock(i, k);
                 storeBlock(a.val.data() + 9 * static_cast<size_t>(k), b);
-                if (a.cols[k] != i) storeBlock(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]), b.transpose());
+                if (a.cols[k] != i)
+                    storeBlock(a.val.data() + 9 * static_cast<size_t>(slotIn(a, a.cols[k], i)), b.transpose());
             }
         }
     }
@@ -630,27 +626,24 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
         GaussSeidelSweep g;
         g.pattern = a.pattern();
         g.val = a.val.data();
-        g.mirror = a.mirror.data();
         g.dinv = L.dinv.data();
         g.r = r;
         g.x = x;
-        g.t = residual ? L.t.data() : nullptr;
+        g.t = nullptr; // t is pulled afterwards (cycle, cyclePlainCoarse)
         g.forward = forward;
         g.fromZero = fromZero && forward;
         const bool parallel =
             n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
         // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
-        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
-        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
-        // the same sums in the same order.
-        if (parallel) g.t = nullptr;
+        // parallel; sequentially, one sweep over all rows in the same order. The residual t is
+        // pulled afterwards, row by row: the same sums in the same order as a push would make.
         forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
             GaussSeidelSweep part = g;
             part.begin = static_cast<int>(i0);
             part.end = static_cast<int>(i1);
             gaussSeidelSweep(part);
         });
-        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
+        return residual && g.fromZero; // t still to pull (the restriction does)
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).
     const double w = mSettings.jacobiWeight;
@@ -672,7 +665,7 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
 // Plain aggregation's coarse correction: r_c = P₀ᵀ t, the coarse cycle, x += α P₀ e (P₀ = S P_tent
 // at level 0, P_tent below).
 void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after the sweep).
     Level& L = mLevels[l];
     Level& C = mLevels[l + 1];
     const BsrMatrix& a = L.a;
@@ -736,7 +729,7 @@ void BlockMultigrid::cycle(int l) {
         for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
         return;
     }
-    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
+    // Restriction r_c = Pᵀ t (t pulled first after the sweep); P's rows lie in range(S).
     if (pull) {
         const BsrPattern p = a.pattern();
         parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
@@ -764,7 +757,7 @@ Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
     return b;
 }
 
-// Â x = S A S x + (I − S) x in double from A's values: row p of level 0 is A's row mOrder[p],
+// Â x = S A S x + (I − S) x in double from A's values: row p of level 0 is A's row order()[p],
 // its slot k A's slot mSrcSlot[k]; S_j x_j for the constrained columns, S_p and (I − S_p) x_p
 // for the constrained rows, on the fly (mKind: level-0 order).
 void BlockMultigrid::multiply(const double* x, double* y) const {
@@ -795,18 +788,18 @@ double BlockMultigrid::multiplyDot(const double* x, double* y, bool single) {
 }
 
 void BlockMultigrid::toLevelOrder(const double* natural, double* level) const {
-    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+    parallelChunks(order().size(), 2048, [&](size_t p0, size_t p1) {
         for (size_t p = p0; p < p1; ++p)
             for (int q = 0; q < 3; ++q)
-                level[3 * p + q] = natural[3 * static_cast<size_t>(mOrder[p]) + q];
+                level[3 * p + q] = natural[3 * static_cast<size_t>(order()[p]) + q];
     });
 }
 
 void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const {
-    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+    parallelChunks(order().size(), 2048, [&](size_t p0, size_t p1) {
         for (size_t p = p0; p < p1; ++p)
             for (int q = 0; q < 3; ++q)
-                natural[3 * static_cast<size_t>(mOrder[p]) + q] = level[3 * p + q];
+                natural[3 * static_cast<size_t>(order()[p]) + q] = level[3 * p + q];
     });
 }
 

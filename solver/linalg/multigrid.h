@@ -29,7 +29,7 @@ enum class MultigridKind { Automatic, Plain, Smoothed };
 // assembled matrix itself, BlockMultigrid::multiply).
 struct BsrMatrix {
     int n = 0;
-    std::vector<int> start, cols, diag, mirror; // mirror[k]: slot of the transposed block
+    std::vector<int> start, cols, diag;
     std::vector<float> val;
 
     int blocks() const { return static_cast<int>(cols.size()); }
@@ -193,8 +193,8 @@ private:
     void aggregatePlain(Level& fine, Level& coarse);
     void coarsenPlain(int l);
     void finishLevel(int l);
-    // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
-    // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
+    // residual: (forward from zero only) return true: t = r − A x is then to be pulled into L.t
+    // row by row (bsrUpperResidualRows; no slot map of transposed blocks is kept to push it).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
     void cyclePlainCoarse(int l, bool pull);
@@ -203,7 +203,7 @@ private:
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
     std::vector<double> mPartial; // chunk sums of the fused dot products
-    std::vector<int> mOrder;      // A's row of each level-0 row
+    const std::vector<int>& order() const { return mLevels[0].colouring.order; } // A's row of each level-0 row
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;

@@ -319,8 +319,8 @@ void galerkinPattern(const BsrMatrix& A, const BlockProlongator& P, std::vector<
 // Row J of C = Pᵀ (A P): Y_s = Σ_r P_rJᵀ A_rs over the fine rows r of column J of P (in
 // increasing order), then C_JK = Σ_s Y_s P_sK for K ≥ J only, over the s in the order first
 // reached, in double. The row's diagonal block is symmetrised (its two triangles are summed in
-// different orders), each block rounded to float and written at (J, K) and, transposed, at
-// (K, J): C is symmetric exactly, and no two rows write the same slot. Scratch per thread (its
+// different orders), each block rounded to float; then each row copies its blocks left of the
+// diagonal as the transposes of those (C is symmetric exactly). Scratch per thread (its
 // contents never outlive a row).
 void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C) {
     parallelChunks(static_cast<size_t>(C.n), 16, [&](size_t J0, size_t J1) {
@@ -365,10 +365,22 @@ void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C)
                 Mat3 b = ConstBlockMap(row.data() + 9 * static_cast<size_t>(m - d0));
                 if (m == d0) b = (0.5 * (b + b.transpose())).eval();
                 storeBlock(C.val.data() + 9 * static_cast<size_t>(m), b);
-                if (m != d0) storeBlock(C.val.data() + 9 * static_cast<size_t>(C.mirror[m]), b.transpose());
                 cpos[C.cols[m]] = -1;
             }
         }
+    });
+    parallelChunks(static_cast<size_t>(C.n), 256, [&](size_t K0, size_t K1) {
+        for (size_t K = K0; K < K1; ++K)
+            for (int m = C.start[K]; m < C.diag[K]; ++m) {
+                const int J = C.cols[m];
+                const int* c0 = C.cols.data() + C.diag[J];
+                const int* c1 = C.cols.data() + C.start[J + 1];
+                const size_t mt = static_cast<size_t>(std::lower_bound(c0, c1, static_cast<int>(K)) - C.cols.data());
+                const float* src = C.val.data() + 9 * mt;
+                float* dst = C.val.data() + 9 * static_cast<size_t>(m);
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) dst[3 * c + r] = src[3 * r + c];
+            }
     });
 }
 

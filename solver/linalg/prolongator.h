@@ -69,10 +69,10 @@ double spectralRadiusDinvA(const BsrMatrix& A, const double* dinv, int iteration
 // P.columns rows.
 void galerkinPattern(const BsrMatrix& A, const BlockProlongator& P, std::vector<int>& start,
                      std::vector<int>& cols);
-// C's values (its pattern from galerkinPattern, diag/mirror set): coarse rows in parallel, each
+// C's values (its pattern from galerkinPattern, diag set): coarse rows in parallel, each
 // summed in double in a fixed order (the same bits for any thread count); row J computes its
-// diagonal and the blocks right of it and writes their transposes below, so C is symmetric
-// exactly, stored in float.
+// diagonal and the blocks right of it, the blocks left of the diagonal are copied as their
+// transposes, so C is symmetric exactly; stored in float.
 void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C);
 
 } // namespace gale::solver
