@@ -487,7 +487,7 @@ size_t BlockMultigrid::bytes() const {
         v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
         v(L.r), v(L.x), v(L.t);
     }
-    v(mPartial), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
+    v(mPartial), v(mSrcSlot), v(mConstrainedRows), v(mKind), v(mNormal), v(mPositions);
     b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double); // and its factor
     return b;
 }
@@ -514,7 +514,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             std::vector<int>().swap(L.graphCols);
         }
     }
-    mSource = A.values();
+    mSource = &A;
     // Level 0: Â = S A S + I − S, in single precision (the smoother's, the set-up's and the
     // single-precision CG products' copy). One pass over A, rows in parallel, with the
     // finiteness check.
@@ -544,6 +544,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     });
     if (anyBad.load()) return false;
     mKind.clear();
+    mConstrainedRows.clear();
     if (!constrained.empty()) {
         mKind.assign(n, 0);
         mNormal.assign(3 * static_cast<size_t>(n), 0.0);
@@ -551,7 +552,10 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             const int i = mLevels[0].visit[v];
             mKind[i] = cons.kind[v];
             for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
+            if (mKind[i]) mConstrainedRows.push_back(i);
         }
+        std::sort(mConstrainedRows.begin(), mConstrainedRows.end());
+        mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()), mConstrainedRows.end());
         // The constrained rows and columns: S_i A_ij S_j (+ I − S_i on the diagonal) from A's
         // double values, rounded once; the transposed block written as its transpose.
         for (int v : constrained) {
@@ -748,7 +752,7 @@ void BlockMultigrid::cycle(int l) {
 Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
     const BsrMatrix& a = mLevels[0].a;
     const int j = a.cols[k];
-    Mat3 b = ConstBlockMap(mSource + 9 * static_cast<size_t>(mSrcSlot[k]));
+    Mat3 b = ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSrcSlot[k]));
     if (mKind.empty() || !(mKind[i] | mKind[j])) return b;
     const Mat3 Si = mKind[i] ? Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) : Mat3::Identity();
     const Mat3 Sj = mKind[j] ? Constraints::filterOf(mKind[j], mNormal.data() + 3 * j) : Mat3::Identity();
@@ -758,27 +762,43 @@ Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
 }
 
 // Â x = S A S x + (I − S) x in double from A's values: row p of level 0 is A's row order()[p],
-// its slot k A's slot mSrcSlot[k]; S_j x_j for the constrained columns, S_p and (I − S_p) x_p
-// for the constrained rows, on the fly (mKind: level-0 order).
+// its slot k A's slot mSrcSlot[k]; y = A x row by row in level-0 column order, then for each
+// constrained row j (in level order) the columns' part A_ij (S_j − I) x_j added to its
+// neighbours i, then the constrained rows' S_i y_i + (I − S_i) x_i (sequential: few rows).
 void BlockMultigrid::multiply(const double* x, double* y) const {
     const BsrMatrix& a = mLevels[0].a;
-    const bool filtered = !mKind.empty();
+    const double* __restrict src = mSource->values();
     parallelChunks(static_cast<size_t>(a.n), 512, [&](size_t i0, size_t i1) {
         for (size_t i = i0; i < i1; ++i) {
-            Vec3 s = Vec3::Zero();
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-                const int j = a.cols[k];
-                Vec3 xj = vec3At(x, j);
-                if (filtered && mKind[j]) xj = Constraints::filterOf(mKind[j], mNormal.data() + 3 * j) * xj;
-                s.noalias() += ConstBlockMap(mSource + 9 * static_cast<size_t>(mSrcSlot[k])) * xj;
+                const double* b = src + 9 * static_cast<size_t>(mSrcSlot[k]);
+                const double* xj = x + 3 * static_cast<size_t>(a.cols[k]);
+                s0 += b[0] * xj[0] + b[3] * xj[1] + b[6] * xj[2];
+                s1 += b[1] * xj[0] + b[4] * xj[1] + b[7] * xj[2];
+                s2 += b[2] * xj[0] + b[5] * xj[1] + b[8] * xj[2];
             }
-            if (filtered && mKind[i]) {
-                const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
-                s = (S * s + (Mat3::Identity() - S) * vec3At(x, i)).eval();
-            }
-            vec3At(y, i) = s;
+            y[3 * i] = s0;
+            y[3 * i + 1] = s1;
+            y[3 * i + 2] = s2;
         }
     });
+    if (mConstrainedRows.empty()) return;
+    const std::vector<int>& start = mSource->blockRowStart();
+    const std::vector<int>& cols = mSource->blockCols();
+    const std::vector<int>& order = mLevels[0].colouring.order;
+    const std::vector<int>& visit = mLevels[0].visit;
+    for (int j : mConstrainedRows) {
+        const Mat3 S = Constraints::filterOf(mKind[j], mNormal.data() + 3 * j);
+        const Vec3 d = (S - Mat3::Identity()) * vec3At(x, j);
+        const int v = order[j];
+        for (int k = start[v]; k < start[v + 1]; ++k) // A_uv = (A_vu)ᵀ, the block of row u
+            vec3At(y, visit[cols[k]]) += ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSource->mirrorSlot(k))) * d;
+    }
+    for (int i : mConstrainedRows) {
+        const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+        vec3At(y, i) = (S * vec3At(y, i) + (Mat3::Identity() - S) * vec3At(x, i)).eval();
+    }
 }
 
 double BlockMultigrid::multiplyDot(const double* x, double* y, bool single) {

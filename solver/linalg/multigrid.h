@@ -208,7 +208,8 @@ private:
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
     std::vector<double> mNormal;
     std::vector<double> mPositions; // A's order, for the rotations
-    const double* mSource = nullptr; // the last refresh's A values (multiply in double)
+    const BlockMatrix* mSource = nullptr; // the last refresh's A (multiply in double)
+    std::vector<int> mConstrainedRows;    // level-0 rows with S ≠ I, increasing
     size_t mPeakBytes = 0;
     int mModes = 3;
     bool mPlain = false;

@@ -52,26 +52,41 @@ void BlockProlongator::buildTranspose() {
         }
 }
 
+// (Written out in scalars: the float blocks are read once each, without temporaries.)
 void BlockProlongator::restrictTo(const double* x, double* y) const {
     parallelChunks(static_cast<size_t>(columns), 256, [&](size_t J0, size_t J1) {
+        const float* __restrict v = val.data();
         for (size_t J = J0; J < J1; ++J) {
-            Vec3 s = Vec3::Zero();
-            for (int t = tStart[J]; t < tStart[J + 1]; ++t)
-                s.noalias() += blockAt(val.data() + 9 * static_cast<size_t>(tSlot[t])).transpose() *
-                               Eigen::Map<const Vec3>(x + 3 * static_cast<size_t>(tRow[t]));
-            Eigen::Map<Vec3>(y + 3 * J) = s;
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (int t = tStart[J]; t < tStart[J + 1]; ++t) {
+                const float* b = v + 9 * static_cast<size_t>(tSlot[t]); // column-major: column c of P_rJ
+                const double* xr = x + 3 * static_cast<size_t>(tRow[t]);  // is row c of its transpose
+                s0 += double(b[0]) * xr[0] + double(b[1]) * xr[1] + double(b[2]) * xr[2];
+                s1 += double(b[3]) * xr[0] + double(b[4]) * xr[1] + double(b[5]) * xr[2];
+                s2 += double(b[6]) * xr[0] + double(b[7]) * xr[1] + double(b[8]) * xr[2];
+            }
+            y[3 * J] = s0;
+            y[3 * J + 1] = s1;
+            y[3 * J + 2] = s2;
         }
     });
 }
 
 void BlockProlongator::prolongAdd(const double* e, double alpha, double* x) const {
     parallelChunks(static_cast<size_t>(rows), 512, [&](size_t r0, size_t r1) {
+        const float* __restrict v = val.data();
         for (size_t r = r0; r < r1; ++r) {
-            Vec3 s = Vec3::Zero();
-            for (int k = start[r]; k < start[r + 1]; ++k)
-                s.noalias() += blockAt(val.data() + 9 * static_cast<size_t>(k)) *
-                               Eigen::Map<const Vec3>(e + 3 * static_cast<size_t>(cols[k]));
-            Eigen::Map<Vec3>(x + 3 * r) += alpha * s;
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (int k = start[r]; k < start[r + 1]; ++k) {
+                const float* b = v + 9 * static_cast<size_t>(k);
+                const double* ec = e + 3 * static_cast<size_t>(cols[k]);
+                s0 += double(b[0]) * ec[0] + double(b[3]) * ec[1] + double(b[6]) * ec[2];
+                s1 += double(b[1]) * ec[0] + double(b[4]) * ec[1] + double(b[7]) * ec[2];
+                s2 += double(b[2]) * ec[0] + double(b[5]) * ec[1] + double(b[8]) * ec[2];
+            }
+            x[3 * r] += alpha * s0;
+            x[3 * r + 1] += alpha * s1;
+            x[3 * r + 2] += alpha * s2;
         }
     });
 }
