@@ -71,7 +71,7 @@ void BsrMatrix::multiply(const double* x, double* y) const {
                    [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
 }
 
-double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial) const {
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const double* dval) const {
     const size_t n3 = 3 * static_cast<size_t>(n);
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     const size_t rowsPerChunk = kReduceChunk / 3;
@@ -81,7 +81,8 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
         for (size_t ch = c0; ch < c1; ++ch) {
             const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
             const size_t i0 = ch * rowsPerChunk;
-            bsrMultiplyRows(p, val.data(), x, y, i0, i1);
+            if (dval) bsrMultiplyRows(p, dval, x, y, i0, i1);
+            else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
             double s = 0.0;
             for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
             partial[ch] = s;
@@ -317,6 +318,7 @@ void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
     c.cols.shrink_to_fit();
     finishPattern(c);
     c.val.assign(9 * c.cols.size() + kBsrPad, 0.0f);
+    coarse.dval.assign(c.val.size(), 0.0);
     fine.coarseSlot.resize(a.cols.size());
     for (int i = 0; i < n; ++i)
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
@@ -335,25 +337,27 @@ void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
 // I − S part and aggregates with a direction no member can move in get an identity there.
 void BlockMultigrid::coarsenPlain(int l) {
     Level& f = mLevels[l];
-    BsrMatrix& c = mLevels[l + 1].a;
+    Level& C = mLevels[l + 1];
+    BsrMatrix& c = C.a;
     const BsrMatrix& a = f.a;
-    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
+    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel),
+    // in double (finishLevel rounds each level for the smoother).
     parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
         for (int K = c.start[I0]; K < c.start[I1]; ++K) {
             double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
             for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
-                const float* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
+                const double* __restrict src = f.dval.data() + 9 * static_cast<size_t>(f.gather[m]);
                 for (int q = 0; q < 9; ++q) sum[q] += src[q];
             }
-            for (int q = 0; q < 9; ++q) c.val[9 * static_cast<size_t>(K) + q] = static_cast<float>(sum[q]);
+            std::copy(sum, sum + 9, C.dval.data() + 9 * static_cast<size_t>(K));
         }
     });
     if (l != 0 || mKind.empty()) return;
     for (int i = 0; i < a.n; ++i) {
         if (!mKind[i]) continue;
         // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
-        float* D = c.val.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]]);
-        storeBlock(D, blockAt(D) - (Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i)));
+        BlockMap(C.dval.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
+            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
     }
     for (int I = 0; I < c.n; ++I) {
         bool any = false;
@@ -365,15 +369,13 @@ void BlockMultigrid::coarsenPlain(int l) {
             B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
         }
         Eigen::SelfAdjointEigenSolver<Mat3> es(B);
-        float* D = c.val.data() + 9 * static_cast<size_t>(c.diag[I]);
-        Mat3 d = blockAt(D);
+        BlockMap d(C.dval.data() + 9 * static_cast<size_t>(c.diag[I]));
         const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
         for (int e = 0; e < 3; ++e)
             if (es.eigenvalues()[e] < 1e-8) {
                 const Vec3 v = es.eigenvectors().col(e);
                 d += scale * v * v.transpose();
             }
-        storeBlock(D, d);
     }
 }
 
@@ -457,6 +459,11 @@ void BlockMultigrid::coarsenValues(int l, std::vector<double>& fineB, std::vecto
 // needs only t).
 void BlockMultigrid::finishLevel(int l) {
     Level& L = mLevels[l];
+    if (l != 0 && !L.dval.empty()) { // plain aggregation: the smoother's copy of the sums
+        parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
+            for (size_t k = k0; k < k1; ++k) L.a.val[k] = static_cast<float>(L.dval[k]);
+        });
+    }
     L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
     std::fill(L.dinv.end() - kBsrPad, L.dinv.end(), 0.0);
     // The inverse of the single-precision diagonal, so that every sweep reads one matrix
@@ -480,7 +487,7 @@ size_t BlockMultigrid::bytes() const {
     size_t b = 0;
     auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
     for (const Level& L : mLevels) {
-        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.val), v(L.dinv);
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.val), v(L.dval), v(L.dinv);
         v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
         v(L.dead), v(L.graphStart), v(L.graphCols), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
         v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot);
@@ -522,6 +529,9 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     const int n = a.n;
     std::vector<float>& low = a.val;
     std::fill(low.end() - kBsrPad, low.end(), 0.0f);
+    std::vector<double>& dval = mLevels[0].dval;
+    if (plain) dval.resize(a.val.size(), 0.0);
+    else std::vector<double>().swap(dval);
     std::atomic<uint32_t> anyBad{0};
     parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
         const double* __restrict src = A.values();
@@ -530,6 +540,8 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         for (int k = k0; k < k1; ++k) {
             const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
             for (int q = 0; q < 9; ++q) lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
+            if (plain)
+                for (int q = 0; q < 9; ++q) dval[9 * static_cast<size_t>(k) + q] = s[q];
         }
         // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or
         // a value beyond float range, which the smoother could not use either); integer bit
@@ -556,9 +568,32 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         }
         std::sort(mConstrainedRows.begin(), mConstrainedRows.end());
         mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()), mConstrainedRows.end());
-        // The constrained rows and columns: S_i A_ij S_j (+ I − S_i on the diagonal) from A's
-        // double values, rounded once; the transposed block written as its transpose.
+        // Plain aggregation: the double copy filtered in place, row then column, each block
+        // then rounded (the path before issue 26).
+        auto lower = [&](int k) {
+            for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
+                low[q] = static_cast<float>(dval[q]);
+        };
         for (int v : constrained) {
+            if (!plain) break;
+            const int i = mLevels[0].visit[v];
+            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                const int kt = slotIn(a, a.cols[k], i);
+                BlockMap row(dval.data() + 9 * static_cast<size_t>(k));
+                row = (S * row).eval();
+                BlockMap col(dval.data() + 9 * static_cast<size_t>(kt));
+                col = (col * S).eval();
+                lower(k);
+                lower(kt);
+            }
+            BlockMap(dval.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+            lower(a.diag[i]);
+        }
+        // Smoothed: S_i A_ij S_j (+ I − S_i on the diagonal) from A's double values, rounded
+        // once; the transposed block written as its transpose.
+        for (int v : constrained) {
+            if (plain) break;
             const int i = mLevels[0].visit[v];
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                 const Mat3 b = levelZeroBlock(i, k);
@@ -602,6 +637,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         }
     }
     mHaveCoarse = true;
+    mPeakBytes = std::max(mPeakBytes, bytes());
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
     // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
     const BsrMatrix& c = mLevels.back().a;
@@ -611,7 +647,9 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     for (int I = 0; I < c.n; ++I)
         for (int k = c.start[I]; k < c.start[I + 1]; ++k)
             mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) =
-                mLevels.size() == 1 ? levelZeroBlock(I, k) : blockAt(c.val.data() + 9 * static_cast<size_t>(k));
+                mPlain                ? ConstBlockMap(mLevels.back().dval.data() + 9 * static_cast<size_t>(k))
+                : mLevels.size() == 1 ? levelZeroBlock(I, k)
+                                      : blockAt(c.val.data() + 9 * static_cast<size_t>(k));
     mCoarseLlt.compute(mCoarseDense);
     mCoarseOk = mCoarseLlt.info() == Eigen::Success;
     return true;
@@ -767,6 +805,13 @@ Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
 // neighbours i, then the constrained rows' S_i y_i + (I − S_i) x_i (sequential: few rows).
 void BlockMultigrid::multiply(const double* x, double* y) const {
     const BsrMatrix& a = mLevels[0].a;
+    if (mPlain) { // the double copy (plain aggregation keeps one)
+        const BsrPattern p = a.pattern();
+        const double* dval = mLevels[0].dval.data();
+        parallelChunks(static_cast<size_t>(a.n), 512,
+                       [&](size_t i0, size_t i1) { bsrMultiplyRows(p, dval, x, y, i0, i1); });
+        return;
+    }
     const double* __restrict src = mSource->values();
     parallelChunks(static_cast<size_t>(a.n), 512, [&](size_t i0, size_t i1) {
         for (size_t i = i0; i < i1; ++i) {
@@ -803,6 +848,7 @@ void BlockMultigrid::multiply(const double* x, double* y) const {
 
 double BlockMultigrid::multiplyDot(const double* x, double* y, bool single) {
     if (single) return mLevels[0].a.multiplyDot(x, y, mPartial);
+    if (mPlain) return mLevels[0].a.multiplyDot(x, y, mPartial, mLevels[0].dval.data());
     multiply(x, y);
     return deterministicDot(x, y, 3 * static_cast<size_t>(mLevels[0].a.n));
 }

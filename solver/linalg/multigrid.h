@@ -37,8 +37,10 @@ struct BsrMatrix {
     // y = M x, parallel over rows (deterministic: each row is summed in column order).
     void multiply(const double* x, double* y) const;
     // y = M x and returns xᵀy, summed in chunks of kReduceChunk entries like deterministicDot
-    // (same bits; one pass over x and y instead of two). `partial` is scratch.
-    double multiplyDot(const double* x, double* y, std::vector<double>& partial) const;
+    // (same bits; one pass over x and y instead of two). `partial` is scratch. With `dval`
+    // (these blocks in double), the product reads those instead of val.
+    double multiplyDot(const double* x, double* y, std::vector<double>& partial,
+                       const double* dval = nullptr) const;
 };
 
 // Smoothed-aggregation AMG (Vaněk, Mandel, Brezina 1996) for the filtered system
@@ -80,12 +82,14 @@ struct BsrMatrix {
 // passed to apply, multiply and
 // multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder).
 //
-// Memory (bench/README.md, issue 26 fourth pass): every level, its diagonal inverses and the
-// prolongators are held in single precision only (half the memory traffic; the V-cycle only
+// Memory (bench/README.md, issue 26 fourth pass): with smoothed aggregation every level and
+// the prolongators are held in single precision only (half the memory traffic; the V-cycle only
 // approximates Â⁻¹ anyway; the set-up reads them and sums in double). Conjugate gradient's
 // double-precision products (multiply, multiplyDot without `single`) read the assembled A
 // itself through the level-0 slot map, filtering on the fly, so no double copy of Â is held.
 // The near-null space and the tentative prolongator are set-up scratch, freed by refresh.
+// Plain aggregation (small meshes) keeps its levels in double too, as before, so that its
+// results stay those of the path before issue 26 bit for bit.
 class BlockMultigrid {
 public:
     struct Settings {
@@ -166,6 +170,9 @@ public:
 private:
     struct Level {
         BsrMatrix a;                   // in single precision (the smoother's and set-up's copy)
+        std::vector<double> dval;      // plain aggregation only: a's values in double, summed
+                                       // into the next level and read by CG's double products
+                                       // (the path before issue 26, kept bit for bit)
         std::vector<double> dinv;      // 9 per row: inverse diagonal block (+ kBsrPad), double: the
                                        // sweep then solves its row to rounding, as the fused
                                        // residual assumes (the V-cycle stays symmetric)
