@@ -357,7 +357,7 @@ void BlockMultigrid::coarsenPlain(int l) {
         if (!mKind[i]) continue;
         // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
         BlockMap(C.dval.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
-            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            Mat3::Identity() - Constraints::filterOf(mKind[i], normalOf(i));
     }
     for (int I = 0; I < c.n; ++I) {
         bool any = false;
@@ -366,7 +366,7 @@ void BlockMultigrid::coarsenPlain(int l) {
         Mat3 B = Mat3::Zero();
         for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) {
             const int i = f.plainMembers[m];
-            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            B += Constraints::filterOf(mKind[i], normalOf(i));
         }
         Eigen::SelfAdjointEigenSolver<Mat3> es(B);
         BlockMap d(C.dval.data() + 9 * static_cast<size_t>(c.diag[I]));
@@ -403,7 +403,7 @@ void BlockMultigrid::levelZeroNullSpace(std::vector<double>& nullB) const {
             for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
                 const int i = g.members[t];
                 const Mat3 S = mKind.empty() ? Mat3::Identity()
-                                             : Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+                                             : Constraints::filterOf(mKind[i], normalOf(i));
                 double* B = nullB.data() + stride * i;
                 BlockMap translations(B);
                 translations = S;
@@ -557,17 +557,21 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     if (anyBad.load()) return false;
     mKind.clear();
     mConstrainedRows.clear();
+    mNormal.clear();
     if (!constrained.empty()) {
         mKind.assign(n, 0);
-        mNormal.assign(3 * static_cast<size_t>(n), 0.0);
         for (int v : constrained) { // A's row v is level-0 row visit[v]
             const int i = mLevels[0].visit[v];
             mKind[i] = cons.kind[v];
-            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
             if (mKind[i]) mConstrainedRows.push_back(i);
         }
         std::sort(mConstrainedRows.begin(), mConstrainedRows.end());
         mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()), mConstrainedRows.end());
+        mNormal.assign(3 * mConstrainedRows.size(), 0.0); // the normals of those rows only
+        for (size_t c = 0; c < mConstrainedRows.size(); ++c) {
+            const int v = mLevels[0].colouring.order[mConstrainedRows[c]];
+            for (int q = 0; q < 3; ++q) mNormal[3 * c + q] = cons.normal[3 * static_cast<size_t>(v) + q];
+        }
         // Plain aggregation: the double copy filtered in place, row then column, each block
         // then rounded (the path before issue 26).
         auto lower = [&](int k) {
@@ -577,7 +581,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         for (int v : constrained) {
             if (!plain) break;
             const int i = mLevels[0].visit[v];
-            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            const Mat3 S = Constraints::filterOf(mKind[i], normalOf(i));
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                 const int kt = slotIn(a, a.cols[k], i);
                 BlockMap row(dval.data() + 9 * static_cast<size_t>(k));
@@ -721,7 +725,7 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
                 if (pull) bsrUpperResidualRows(p, a.val.data(), L.xp, L.t.data(), i, i + 1);
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
                 if (filtered && mKind[i])
-                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                    t = Constraints::filterOf(mKind[i], normalOf(i)) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
@@ -734,7 +738,7 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
         for (size_t i = i0; i < i1; ++i) {
             const int I = L.plainAgg[i];
             Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
-            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], normalOf(i)) * e;
             for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
         }
     });
@@ -785,6 +789,14 @@ void BlockMultigrid::cycle(int l) {
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
 }
 
+const double* BlockMultigrid::normalOf(int i) const {
+    static const double none[3] = {0.0, 0.0, 0.0}; // (the filters of kinds 0 and 1 read none)
+    if (mKind[i] != 2) return none;
+    const size_t c = static_cast<size_t>(
+        std::lower_bound(mConstrainedRows.begin(), mConstrainedRows.end(), i) - mConstrainedRows.begin());
+    return mNormal.data() + 3 * c;
+}
+
 // Block k of level-0 row i of Â = S A S + I − S in double, from A's values (a one-level
 // hierarchy factors Â itself: an exact solve).
 Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
@@ -792,8 +804,8 @@ Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
     const int j = a.cols[k];
     Mat3 b = ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSrcSlot[k]));
     if (mKind.empty() || !(mKind[i] | mKind[j])) return b;
-    const Mat3 Si = mKind[i] ? Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) : Mat3::Identity();
-    const Mat3 Sj = mKind[j] ? Constraints::filterOf(mKind[j], mNormal.data() + 3 * j) : Mat3::Identity();
+    const Mat3 Si = mKind[i] ? Constraints::filterOf(mKind[i], normalOf(i)) : Mat3::Identity();
+    const Mat3 Sj = mKind[j] ? Constraints::filterOf(mKind[j], normalOf(j)) : Mat3::Identity();
     b = (Si * b * Sj).eval();
     if (i == j) b += Mat3::Identity() - Si;
     return b;
@@ -834,14 +846,14 @@ void BlockMultigrid::multiply(const double* x, double* y) const {
     const std::vector<int>& order = mLevels[0].colouring.order;
     const std::vector<int>& visit = mLevels[0].visit;
     for (int j : mConstrainedRows) {
-        const Mat3 S = Constraints::filterOf(mKind[j], mNormal.data() + 3 * j);
+        const Mat3 S = Constraints::filterOf(mKind[j], normalOf(j));
         const Vec3 d = (S - Mat3::Identity()) * vec3At(x, j);
         const int v = order[j];
         for (int k = start[v]; k < start[v + 1]; ++k) // A_uv = (A_vu)ᵀ, the block of row u
             vec3At(y, visit[cols[k]]) += ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSource->mirrorSlot(k))) * d;
     }
     for (int i : mConstrainedRows) {
-        const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+        const Mat3 S = Constraints::filterOf(mKind[i], normalOf(i));
         vec3At(y, i) = (S * vec3At(y, i) + (Mat3::Identity() - S) * vec3At(x, i)).eval();
     }
 }

@@ -213,7 +213,8 @@ private:
     const std::vector<int>& order() const { return mLevels[0].colouring.order; } // A's row of each level-0 row
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
-    std::vector<double> mNormal;
+    std::vector<double> mNormal; // 3 per mConstrainedRows entry
+    const double* normalOf(int i) const; // the plane normal of level-0 row i (kind 2)
     std::vector<double> mPositions; // A's order, for the rotations
     const BlockMatrix* mSource = nullptr; // the last refresh's A (multiply in double)
     std::vector<int> mConstrainedRows;    // level-0 rows with S ≠ I, increasing
