@@ -24,7 +24,9 @@ using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
 
 // A single-precision block (column-major, 9 floats) as a double 3×3 matrix, and back.
-inline Mat3 blockAt(const float* p) { return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>(); }
+inline Mat3 blockAt(const float* p) {
+    return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>();
+}
 inline void storeBlock(float* p, const Mat3& m) {
     Eigen::Map<Eigen::Matrix3f> out(p);
     out = m.cast<float>();
@@ -71,7 +73,8 @@ void BsrMatrix::multiply(const double* x, double* y) const {
                    [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
 }
 
-double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const double* dval) const {
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial,
+                              const double* dval) const {
     const size_t n3 = 3 * static_cast<size_t>(n);
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     const size_t rowsPerChunk = kReduceChunk / 3;
@@ -81,7 +84,8 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
         for (size_t ch = c0; ch < c1; ++ch) {
             const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
             const size_t i0 = ch * rowsPerChunk;
-            if (dval) bsrMultiplyRows(p, dval, x, y, i0, i1);
+            if (dval)
+                bsrMultiplyRows(p, dval, x, y, i0, i1);
             else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
             double s = 0.0;
             for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
@@ -397,13 +401,14 @@ void BlockMultigrid::levelZeroNullSpace(std::vector<double>& nullB) const {
                     c += vec3At(mPositions.data(), order()[g.members[t]]);
                 c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
                 for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
-                    radius = std::max(radius, (vec3At(mPositions.data(), order()[g.members[t]]) - c).norm());
+                    radius = std::max(
+                        radius, (vec3At(mPositions.data(), order()[g.members[t]]) - c).norm());
             }
             const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
             for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
                 const int i = g.members[t];
-                const Mat3 S = mKind.empty() ? Mat3::Identity()
-                                             : Constraints::filterOf(mKind[i], normalOf(i));
+                const Mat3 S =
+                    mKind.empty() ? Mat3::Identity() : Constraints::filterOf(mKind[i], normalOf(i));
                 double* B = nullB.data() + stride * i;
                 BlockMap translations(B);
                 translations = S;
@@ -435,7 +440,9 @@ void BlockMultigrid::coarsenValues(int l, std::vector<double>& fineB, std::vecto
     tentativeProlongator(f.agg, mModes, fineB, Q, coarseB, c.dead);
     smoothProlongator(f.a, f.agg, mModes / 3, omega, Q, f.P);
     galerkinValues(f.a, f.P, c.a);
-    mPeakBytes = std::max(mPeakBytes, bytes() + sizeof(double) * (fineB.capacity() + coarseB.capacity() + Q.capacity()));
+    mPeakBytes =
+        std::max(mPeakBytes,
+                 bytes() + sizeof(double) * (fineB.capacity() + coarseB.capacity() + Q.capacity()));
     for (int J = 0; J < c.a.n; ++J) {
         const uint8_t* dead = c.dead.data() + 3 * static_cast<size_t>(J);
         if (!(dead[0] | dead[1] | dead[2])) continue;
@@ -489,7 +496,8 @@ size_t BlockMultigrid::bytes() const {
     for (const Level& L : mLevels) {
         v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.val), v(L.dval), v(L.dinv);
         v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
-        v(L.dead), v(L.graphStart), v(L.graphCols), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
+        v(L.dead), v(L.graphStart), v(L.graphCols), v(L.agg.nodeAgg), v(L.agg.memberStart),
+            v(L.agg.members);
         v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot);
         v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
         v(L.r), v(L.x), v(L.t);
@@ -530,8 +538,10 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     std::vector<float>& low = a.val;
     std::fill(low.end() - kBsrPad, low.end(), 0.0f);
     std::vector<double>& dval = mLevels[0].dval;
-    if (plain) dval.resize(a.val.size(), 0.0);
-    else std::vector<double>().swap(dval);
+    if (plain)
+        dval.resize(a.val.size(), 0.0);
+    else
+        std::vector<double>().swap(dval);
     std::atomic<uint32_t> anyBad{0};
     parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
         const double* __restrict src = A.values();
@@ -539,7 +549,8 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         const int k0 = a.start[i0], k1 = a.start[i1];
         for (int k = k0; k < k1; ++k) {
             const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
-            for (int q = 0; q < 9; ++q) lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
+            for (int q = 0; q < 9; ++q)
+                lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
             if (plain)
                 for (int q = 0; q < 9; ++q) dval[9 * static_cast<size_t>(k) + q] = s[q];
         }
@@ -566,11 +577,13 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
             if (mKind[i]) mConstrainedRows.push_back(i);
         }
         std::sort(mConstrainedRows.begin(), mConstrainedRows.end());
-        mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()), mConstrainedRows.end());
+        mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()),
+                               mConstrainedRows.end());
         mNormal.assign(3 * mConstrainedRows.size(), 0.0); // the normals of those rows only
         for (size_t c = 0; c < mConstrainedRows.size(); ++c) {
             const int v = mLevels[0].colouring.order[mConstrainedRows[c]];
-            for (int q = 0; q < 3; ++q) mNormal[3 * c + q] = cons.normal[3 * static_cast<size_t>(v) + q];
+            for (int q = 0; q < 3; ++q)
+                mNormal[3 * c + q] = cons.normal[3 * static_cast<size_t>(v) + q];
         }
         // Plain aggregation: the double copy filtered in place, row then column, each block
         // then rounded (the path before issue 26).
@@ -603,7 +616,8 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
                 const Mat3 b = levelZeroBlock(i, k);
                 storeBlock(a.val.data() + 9 * static_cast<size_t>(k), b);
                 if (a.cols[k] != i)
-                    storeBlock(a.val.data() + 9 * static_cast<size_t>(slotIn(a, a.cols[k], i)), b.transpose());
+                    storeBlock(a.val.data() + 9 * static_cast<size_t>(slotIn(a, a.cols[k], i)),
+                               b.transpose());
             }
         }
     }
@@ -651,7 +665,7 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     for (int I = 0; I < c.n; ++I)
         for (int k = c.start[I]; k < c.start[I + 1]; ++k)
             mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) =
-                mPlain                ? ConstBlockMap(mLevels.back().dval.data() + 9 * static_cast<size_t>(k))
+                mPlain ? ConstBlockMap(mLevels.back().dval.data() + 9 * static_cast<size_t>(k))
                 : mLevels.size() == 1 ? levelZeroBlock(I, k)
                                       : blockAt(c.val.data() + 9 * static_cast<size_t>(k));
     mCoarseLlt.compute(mCoarseDense);
@@ -724,8 +738,7 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
                 const int i = L.plainMembers[m];
                 if (pull) bsrUpperResidualRows(p, a.val.data(), L.xp, L.t.data(), i, i + 1);
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i])
-                    t = Constraints::filterOf(mKind[i], normalOf(i)) * t;
+                if (filtered && mKind[i]) t = Constraints::filterOf(mKind[i], normalOf(i)) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
@@ -792,8 +805,9 @@ void BlockMultigrid::cycle(int l) {
 const double* BlockMultigrid::normalOf(int i) const {
     static const double none[3] = {0.0, 0.0, 0.0}; // (the filters of kinds 0 and 1 read none)
     if (mKind[i] != 2) return none;
-    const size_t c = static_cast<size_t>(
-        std::lower_bound(mConstrainedRows.begin(), mConstrainedRows.end(), i) - mConstrainedRows.begin());
+    const size_t c =
+        static_cast<size_t>(std::lower_bound(mConstrainedRows.begin(), mConstrainedRows.end(), i) -
+                            mConstrainedRows.begin());
     return mNormal.data() + 3 * c;
 }
 
@@ -850,7 +864,9 @@ void BlockMultigrid::multiply(const double* x, double* y) const {
         const Vec3 d = (S - Mat3::Identity()) * vec3At(x, j);
         const int v = order[j];
         for (int k = start[v]; k < start[v + 1]; ++k) // A_uv = (A_vu)ᵀ, the block of row u
-            vec3At(y, visit[cols[k]]) += ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSource->mirrorSlot(k))) * d;
+            vec3At(y, visit[cols[k]]) +=
+                ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSource->mirrorSlot(k))) *
+                d;
     }
     for (int i : mConstrainedRows) {
         const Mat3 S = Constraints::filterOf(mKind[i], normalOf(i));

@@ -210,10 +210,12 @@ private:
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
     std::vector<double> mPartial; // chunk sums of the fused dot products
-    const std::vector<int>& order() const { return mLevels[0].colouring.order; } // A's row of each level-0 row
+    const std::vector<int>& order() const {
+        return mLevels[0].colouring.order;
+    }                             // A's row of each level-0 row
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
-    std::vector<double> mNormal; // 3 per mConstrainedRows entry
+    std::vector<double> mNormal;         // 3 per mConstrainedRows entry
     const double* normalOf(int i) const; // the plane normal of level-0 row i (kind 2)
     std::vector<double> mPositions; // A's order, for the rotations
     const BlockMatrix* mSource = nullptr; // the last refresh's A (multiply in double)

@@ -476,9 +476,10 @@ TEST_CASE("multigrid: double products read the assembled matrix; levels are exac
             for (int i = 0; i < a.n; ++i)
                 for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
                     const int j = a.cols[k];
-                    const int kt = static_cast<int>(
-                        std::lower_bound(a.cols.begin() + a.start[j], a.cols.begin() + a.start[j + 1], i) -
-                        a.cols.begin());
+                    const int kt =
+                        static_cast<int>(std::lower_bound(a.cols.begin() + a.start[j],
+                                                          a.cols.begin() + a.start[j + 1], i) -
+                                         a.cols.begin());
                     REQUIRE(kt < a.start[j + 1]);
                     for (int r = 0; r < 3; ++r)
                         for (int c = 0; c < 3; ++c)

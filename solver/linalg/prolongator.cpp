@@ -20,7 +20,9 @@ using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
 
 // A single-precision block (column-major, 9 floats) as a double 3×3 matrix.
-inline Mat3 blockAt(const float* p) { return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>(); }
+inline Mat3 blockAt(const float* p) {
+    return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>();
+}
 inline void storeBlock(float* p, const Mat3& m) {
     Eigen::Map<Eigen::Matrix3f> out(p);
     out = m.cast<float>();
@@ -68,8 +70,10 @@ void BlockProlongator::restrictTo(const double* x, double* y) const {
                     __builtin_prefetch(p + 8);
                     __builtin_prefetch(x + 3 * static_cast<size_t>(tRow[t + ahead]));
                 }
-                const float* b = v + 9 * static_cast<size_t>(tSlot[t]); // column-major: column c of P_rJ
-                const double* xr = x + 3 * static_cast<size_t>(tRow[t]);  // is row c of its transpose
+                const float* b =
+                    v + 9 * static_cast<size_t>(tSlot[t]); // column-major: column c of P_rJ
+                const double* xr =
+                    x + 3 * static_cast<size_t>(tRow[t]); // is row c of its transpose
                 s0 += double(b[0]) * xr[0] + double(b[1]) * xr[1] + double(b[2]) * xr[2];
                 s1 += double(b[3]) * xr[0] + double(b[4]) * xr[1] + double(b[5]) * xr[2];
                 s2 += double(b[6]) * xr[0] + double(b[7]) * xr[1] + double(b[8]) * xr[2];
@@ -360,7 +364,8 @@ void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C)
             Y.clear();
             for (int t = P.tStart[J]; t < P.tStart[J + 1]; ++t) {
                 const int r = P.tRow[t];
-                const Mat3 Wt = blockAt(P.val.data() + 9 * static_cast<size_t>(P.tSlot[t])).transpose();
+                const Mat3 Wt =
+                    blockAt(P.val.data() + 9 * static_cast<size_t>(P.tSlot[t])).transpose();
                 for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
                     const int s = A.cols[k];
                     if (pos[s] < 0) {
@@ -399,7 +404,8 @@ void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C)
                 const int J = C.cols[m];
                 const int* c0 = C.cols.data() + C.diag[J];
                 const int* c1 = C.cols.data() + C.start[J + 1];
-                const size_t mt = static_cast<size_t>(std::lower_bound(c0, c1, static_cast<int>(K)) - C.cols.data());
+                const size_t mt = static_cast<size_t>(
+                    std::lower_bound(c0, c1, static_cast<int>(K)) - C.cols.data());
                 const float* src = C.val.data() + 9 * mt;
                 float* dst = C.val.data() + 9 * static_cast<size_t>(m);
                 for (int r = 0; r < 3; ++r)
