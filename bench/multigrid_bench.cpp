@@ -11,6 +11,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -48,7 +49,7 @@ struct Outcome {
     int iterations = 0;
     double setup = 0.0, solve = 0.0; // seconds, best of the repeats
     double residual = 0.0;
-    size_t bytes = 0;
+    size_t bytes = 0, peakBytes = 0; // held between solves; the most during the set-up
     int levels = 0;
     VecX dv;
 };
@@ -85,6 +86,7 @@ Outcome runSolve(const ClothSystem& s, const Variant& v, double tol, int threads
             o.dv = dv;
         }
         o.bytes = solver.multigrid().bytes();
+        o.peakBytes = std::max(o.bytes, solver.multigrid().peakBytes());
         o.levels = solver.multigrid().levelCount();
     });
     return o;
@@ -191,9 +193,9 @@ const Variant kSaRot{"sa-rotations", true, true, 1};
 // ---- 1. iterations and cost against resolution ------------------------------------------------
 void scalingBench(bool quick, int onlySize) {
     std::printf("== scaling: one filtered solve (pins + contact patch), tol 1e-3, zero start\n");
-    std::printf("%-9s %-7s %5s %-19s %3s %5s %6s %9s %9s %9s %8s %7s\n", "mesh", "h", "n",
+    std::printf("%-9s %-7s %5s %-19s %3s %5s %6s %9s %9s %9s %8s %8s %7s\n", "mesh", "h", "n",
                 "preconditioner", "thr", "its", "levels", "setup_us/v", "solve_us/v", "total/base",
-                "B/vertex", "maxdiff");
+                "B/vertex", "peak_B/v", "maxdiff");
     const std::vector<int> sizes =
         quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128, 256};
     for (bool irregular : {false, true})
@@ -207,10 +209,10 @@ void scalingBench(bool quick, int onlySize) {
                 const double baseTotal = base.setup + base.solve;
                 auto row = [&](const char* name, int threads, const Outcome& o, double diff) {
                     std::printf(
-                        "%-9s 1/%-5.0f %5d %-19s %3d %5d %6d %9.3f %9.3f %9.2f %8.0f %7.1e\n",
+                        "%-9s 1/%-5.0f %5d %-19s %3d %5d %6d %9.3f %9.3f %9.2f %8.0f %8.0f %7.1e\n",
                         irregular ? "irregular" : "grid", 1.0 / h, n, name, threads, o.iterations,
                         o.levels, 1e6 * o.setup / nv, 1e6 * o.solve / nv,
-                        (o.setup + o.solve) / baseTotal, o.bytes / nv, diff);
+                        (o.setup + o.solve) / baseTotal, o.bytes / nv, o.peakBytes / nv, diff);
                     std::fflush(stdout);
                 };
                 row(kPlain.name, 1, base, 0.0);

@@ -23,6 +23,15 @@ namespace {
 using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
 
+// A single-precision block (column-major, 9 floats) as a double 3×3 matrix, and back.
+inline Mat3 blockAt(const float* p) {
+    return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>();
+}
+inline void storeBlock(float* p, const Mat3& m) {
+    Eigen::Map<Eigen::Matrix3f> out(p);
+    out = m.cast<float>();
+}
+
 // The multicolour ordering of a level (types.h, ColouredBlocks): its rows, in natural order, cut
 // into blocks of `rowBlock`; two blocks neighbour when a row of one shares a matrix block
 // with a row of the other. Without `multicolour`: the natural order, one block.
@@ -47,14 +56,10 @@ int slotIn(const BsrMatrix& m, int i, int j) {
     return static_cast<int>(std::lower_bound(b, e, j) - m.cols.begin());
 }
 
-// diag and mirror of a pattern with sorted columns, symmetric, the diagonal present.
+// diag of a pattern with sorted columns, symmetric, the diagonal present.
 void finishPattern(BsrMatrix& m) {
     m.diag.resize(m.n);
-    m.mirror.resize(m.cols.size());
-    for (int i = 0; i < m.n; ++i) {
-        m.diag[i] = slotIn(m, i, i);
-        for (int k = m.start[i]; k < m.start[i + 1]; ++k) m.mirror[k] = slotIn(m, m.cols[k], i);
-    }
+    for (int i = 0; i < m.n; ++i) m.diag[i] = slotIn(m, i, i);
 }
 
 } // namespace
@@ -68,7 +73,8 @@ void BsrMatrix::multiply(const double* x, double* y) const {
                    [&](size_t i0, size_t i1) { bsrMultiplyRows(p, val.data(), x, y, i0, i1); });
 }
 
-double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single) const {
+double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& partial,
+                              const double* dval) const {
     const size_t n3 = 3 * static_cast<size_t>(n);
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     const size_t rowsPerChunk = kReduceChunk / 3;
@@ -78,7 +84,8 @@ double BsrMatrix::multiplyDot(const double* x, double* y, std::vector<double>& p
         for (size_t ch = c0; ch < c1; ++ch) {
             const size_t i1 = std::min(static_cast<size_t>(n), (ch + 1) * rowsPerChunk);
             const size_t i0 = ch * rowsPerChunk;
-            if (single) bsrMultiplyRows(p, single, x, y, i0, i1);
+            if (dval)
+                bsrMultiplyRows(p, dval, x, y, i0, i1);
             else bsrMultiplyRows(p, val.data(), x, y, i0, i1);
             double s = 0.0;
             for (size_t k = 3 * i0; k < 3 * i1; ++k) s += x[k] * y[k]; // in entry order, as deterministicDot
@@ -98,7 +105,7 @@ BlockMultigrid::Settings& BlockMultigrid::defaults() {
     return settings;
 }
 
-// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row mOrder[p]; its
+// Level 0: A's pattern renumbered in colour order (row p of level 0 is A's row order()[p]; its
 // slot k holds A's slot mSrcSlot[k]).
 void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     mLevels.assign(1, Level());
@@ -109,16 +116,15 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
     const std::vector<int>& cols = A.blockCols();
     L.colouring =
         colourRows(mSettings.multicolour, mSettings.rowBlock, n, start.data(), cols.data());
-    mOrder = L.colouring.order;
     L.visit.resize(n);
-    for (int p = 0; p < n; ++p) L.visit[mOrder[p]] = p;
+    for (int p = 0; p < n; ++p) L.visit[order()[p]] = p;
     a.n = n;
     a.start.assign(n + 1, 0);
     a.cols.clear();
     mSrcSlot.clear();
     std::vector<std::pair<int, int>> row; // (level-0 column, A's slot)
     for (int p = 0; p < n; ++p) {
-        const int i = mOrder[p];
+        const int i = order()[p];
         row.clear();
         for (int k = start[i]; k < start[i + 1]; ++k) row.push_back({L.visit[cols[k]], k});
         std::sort(row.begin(), row.end());
@@ -128,8 +134,10 @@ void BlockMultigrid::buildHierarchy(const BlockMatrix& A) {
         }
         a.start[p + 1] = static_cast<int>(a.cols.size());
     }
+    a.cols.shrink_to_fit();
+    mSrcSlot.shrink_to_fit();
     finishPattern(a);
-    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0);
+    a.val.assign(9 * a.cols.size() + kBsrPad, 0.0f);
     mPatternRows = A.size();
     mPatternSlots = A.slotCount();
 }
@@ -197,8 +205,9 @@ bool BlockMultigrid::buildCoarse(int l) {
         cm.cols.insert(cm.cols.end(), row.begin(), row.end());
         cm.start[p + 1] = static_cast<int>(cm.cols.size());
     }
+    cm.cols.shrink_to_fit();
     finishPattern(cm);
-    cm.val.assign(9 * cm.cols.size() + kBsrPad, 0.0);
+    cm.val.assign(9 * cm.cols.size() + kBsrPad, 0.0f);
     // The coarse node graph the next aggregation reads: aggregates neighbour when two of their
     // nodes do (the tentative prolongator's pattern, not the smoothed one's wider stencil: that
     // would grow the aggregates about threefold per level and coarsen too fast).
@@ -215,6 +224,9 @@ bool BlockMultigrid::buildCoarse(int l) {
         c.graphCols.insert(c.graphCols.end(), row.begin(), row.end());
         c.graphStart[J + 1] = static_cast<int>(c.graphCols.size());
     }
+    // This level's node graph is not read again (the next level has its own).
+    std::vector<int>().swap(f.graphStart);
+    std::vector<int>().swap(f.graphCols);
     mLevels.push_back(std::move(c));
     return true;
 }
@@ -307,8 +319,10 @@ void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
         c.cols.insert(c.cols.end(), row.begin(), row.end());
         c.start[P + 1] = static_cast<int>(c.cols.size());
     }
+    c.cols.shrink_to_fit();
     finishPattern(c);
-    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0);
+    c.val.assign(9 * c.cols.size() + kBsrPad, 0.0f);
+    coarse.dval.assign(c.val.size(), 0.0);
     fine.coarseSlot.resize(a.cols.size());
     for (int i = 0; i < n; ++i)
         for (int k = a.start[i]; k < a.start[i + 1]; ++k)
@@ -327,25 +341,27 @@ void BlockMultigrid::aggregatePlain(Level& fine, Level& coarse) {
 // I − S part and aggregates with a direction no member can move in get an identity there.
 void BlockMultigrid::coarsenPlain(int l) {
     Level& f = mLevels[l];
-    BsrMatrix& c = mLevels[l + 1].a;
+    Level& C = mLevels[l + 1];
+    BsrMatrix& c = C.a;
     const BsrMatrix& a = f.a;
-    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel).
+    // Each coarse block the sum of its fine blocks in slot order, gathered (rows in parallel),
+    // in double (finishLevel rounds each level for the smoother).
     parallelChunks(static_cast<size_t>(c.n), 64, [&](size_t I0, size_t I1) {
         for (int K = c.start[I0]; K < c.start[I1]; ++K) {
             double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
             for (int m = f.gatherStart[K]; m < f.gatherStart[K + 1]; ++m) {
-                const double* __restrict src = a.val.data() + 9 * static_cast<size_t>(f.gather[m]);
+                const double* __restrict src = f.dval.data() + 9 * static_cast<size_t>(f.gather[m]);
                 for (int q = 0; q < 9; ++q) sum[q] += src[q];
             }
-            std::copy(sum, sum + 9, c.val.data() + 9 * static_cast<size_t>(K));
+            std::copy(sum, sum + 9, C.dval.data() + 9 * static_cast<size_t>(K));
         }
     });
     if (l != 0 || mKind.empty()) return;
     for (int i = 0; i < a.n; ++i) {
         if (!mKind[i]) continue;
         // Â_ii = S A_ii S + (I − S); the Galerkin block keeps S A_ii S only.
-        BlockMap(c.val.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
-            Mat3::Identity() - Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+        BlockMap(C.dval.data() + 9 * static_cast<size_t>(c.diag[f.plainAgg[i]])) -=
+            Mat3::Identity() - Constraints::filterOf(mKind[i], normalOf(i));
     }
     for (int I = 0; I < c.n; ++I) {
         bool any = false;
@@ -354,10 +370,10 @@ void BlockMultigrid::coarsenPlain(int l) {
         Mat3 B = Mat3::Zero();
         for (int m = f.plainStart[I]; m < f.plainStart[I + 1]; ++m) {
             const int i = f.plainMembers[m];
-            B += Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            B += Constraints::filterOf(mKind[i], normalOf(i));
         }
         Eigen::SelfAdjointEigenSolver<Mat3> es(B);
-        BlockMap d(c.val.data() + 9 * static_cast<size_t>(c.diag[I]));
+        BlockMap d(C.dval.data() + 9 * static_cast<size_t>(c.diag[I]));
         const double scale = d.trace() > 0.0 ? d.trace() / 3.0 : 1.0;
         for (int e = 0; e < 3; ++e)
             if (es.eigenvalues()[e] < 1e-8) {
@@ -369,12 +385,12 @@ void BlockMultigrid::coarsenPlain(int l) {
 
 // Level 0's near-null space from the positions and filters (multigrid.h): per aggregate its
 // centroid and radius, per row S_i [I | −[x_i − c]× / ρ].
-void BlockMultigrid::levelZeroNullSpace() {
-    Level& L = mLevels[0];
+void BlockMultigrid::levelZeroNullSpace(std::vector<double>& nullB) const {
+    const Level& L = mLevels[0];
     const Aggregates& g = L.agg;
     const int m = mModes;
     const size_t stride = 3 * static_cast<size_t>(m);
-    L.nullB.assign(stride * L.a.n, 0.0);
+    nullB.assign(stride * L.a.n, 0.0);
     const int count = static_cast<int>(g.memberStart.size()) - 1;
     parallelChunks(static_cast<size_t>(count), 64, [&](size_t J0, size_t J1) {
         for (size_t J = J0; J < J1; ++J) {
@@ -382,21 +398,22 @@ void BlockMultigrid::levelZeroNullSpace() {
             double radius = 0.0;
             if (m == 6) {
                 for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
-                    c += vec3At(mPositions.data(), mOrder[g.members[t]]);
+                    c += vec3At(mPositions.data(), order()[g.members[t]]);
                 c /= std::max(1, g.memberStart[J + 1] - g.memberStart[J]);
                 for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t)
-                    radius = std::max(radius, (vec3At(mPositions.data(), mOrder[g.members[t]]) - c).norm());
+                    radius = std::max(
+                        radius, (vec3At(mPositions.data(), order()[g.members[t]]) - c).norm());
             }
             const double inv = radius > 0.0 ? 1.0 / radius : 1.0;
             for (int t = g.memberStart[J]; t < g.memberStart[J + 1]; ++t) {
                 const int i = g.members[t];
-                const Mat3 S = mKind.empty() ? Mat3::Identity()
-                                             : Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
-                double* B = L.nullB.data() + stride * i;
+                const Mat3 S =
+                    mKind.empty() ? Mat3::Identity() : Constraints::filterOf(mKind[i], normalOf(i));
+                double* B = nullB.data() + stride * i;
                 BlockMap translations(B);
                 translations = S;
                 if (m == 6) {
-                    const Vec3 p = inv * (vec3At(mPositions.data(), mOrder[i]) - c);
+                    const Vec3 p = inv * (vec3At(mPositions.data(), order()[i]) - c);
                     Mat3 cross;
                     cross << 0.0, -p.z(), p.y(), p.z(), 0.0, -p.x(), -p.y(), p.x(), 0.0;
                     BlockMap(B + 9) = -S * cross;
@@ -408,22 +425,29 @@ void BlockMultigrid::levelZeroNullSpace() {
 
 // A_{l+1} = P_lᵀ A_l P_l with P_l the smoothed tentative prolongator of B_l (multigrid.h);
 // coarse unknowns no mode reaches get a unit diagonal (their rows and columns are zero).
-void BlockMultigrid::coarsenValues(int l) {
+// fineB: B_l on entry (built here at level 0); coarseB receives B_{l+1}; Q is scratch for the
+// tentative prolongator (set-up scratch, not kept: refresh frees them).
+void BlockMultigrid::coarsenValues(int l, std::vector<double>& fineB, std::vector<double>& coarseB,
+                                   std::vector<double>& Q) {
     Level& f = mLevels[l];
     Level& c = mLevels[l + 1];
-    if (l == 0) levelZeroNullSpace();
+    if (l == 0) levelZeroNullSpace(fineB);
     double omega = 0.0;
     if (mSettings.smoothed) {
         const double rho = spectralRadiusDinvA(f.a, f.dinv.data(), mSettings.powerIterations);
         omega = mSettings.prolongatorDamping / rho;
     }
-    tentativeProlongator(f.agg, mModes, f.nullB, f.Q, c.nullB, c.dead);
-    smoothProlongator(f.a, f.agg, mModes / 3, omega, f.Q, f.P);
+    tentativeProlongator(f.agg, mModes, fineB, Q, coarseB, c.dead);
+    smoothProlongator(f.a, f.agg, mModes / 3, omega, Q, f.P);
     galerkinValues(f.a, f.P, c.a);
+    mPeakBytes =
+        std::max(mPeakBytes,
+                 bytes() + sizeof(double) * (fineB.capacity() + coarseB.capacity() + Q.capacity()));
     for (int J = 0; J < c.a.n; ++J) {
         const uint8_t* dead = c.dead.data() + 3 * static_cast<size_t>(J);
         if (!(dead[0] | dead[1] | dead[2])) continue;
-        BlockMap D(c.a.val.data() + 9 * static_cast<size_t>(c.a.diag[J]));
+        float* Df = c.a.val.data() + 9 * static_cast<size_t>(c.a.diag[J]);
+        Mat3 D = blockAt(Df);
         double live = 0.0;
         int nLive = 0;
         for (int q = 0; q < 3; ++q)
@@ -434,17 +458,17 @@ void BlockMultigrid::coarsenValues(int l) {
         const double scale = nLive > 0 && live > 0.0 ? live / nLive : 1.0;
         for (int q = 0; q < 3; ++q)
             if (dead[q]) D(q, q) = scale;
+        storeBlock(Df, D);
     }
 }
 
-// A level's single-precision copy (level 0's is made by refresh), diagonal inverses and work
-// vectors.
+// A level's diagonal inverses and work vectors (level 0 reads and writes apply's vectors: it
+// needs only t).
 void BlockMultigrid::finishLevel(int l) {
     Level& L = mLevels[l];
-    if (l != 0) {
-        L.lowVal.resize(L.a.val.size());
+    if (l != 0 && !L.dval.empty()) { // plain aggregation: the smoother's copy of the sums
         parallelChunks(L.a.val.size(), 8192, [&](size_t k0, size_t k1) {
-            for (size_t k = k0; k < k1; ++k) L.lowVal[k] = static_cast<float>(L.a.val[k]);
+            for (size_t k = k0; k < k1; ++k) L.a.val[k] = static_cast<float>(L.dval[k]);
         });
     }
     L.dinv.resize(9 * static_cast<size_t>(L.a.n) + kBsrPad);
@@ -452,15 +476,15 @@ void BlockMultigrid::finishLevel(int l) {
     // The inverse of the single-precision diagonal, so that every sweep reads one matrix
     // (the forward and backward sweeps stay exact adjoints: the V-cycle stays symmetric).
     parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; ++i) {
-            const float* d = L.lowVal.data() + 9 * static_cast<size_t>(L.a.diag[i]);
+        for (size_t i = i0; i < i1; ++i)
             BlockMap(L.dinv.data() + 9 * i) =
-                invertBlockOrScale(Eigen::Map<const Eigen::Matrix3f>(d).cast<double>());
-        }
+                invertBlockOrScale(blockAt(L.a.val.data() + 9 * static_cast<size_t>(L.a.diag[i])));
     });
     const size_t n3 = 3 * static_cast<size_t>(L.a.n);
-    L.r.resize(n3);
-    L.x.resize(n3);
+    if (l != 0) {
+        L.r.resize(n3);
+        L.x.resize(n3);
+    }
     L.rp = L.r.data();
     L.xp = L.x.data();
     L.t.resize(n3);
@@ -470,15 +494,16 @@ size_t BlockMultigrid::bytes() const {
     size_t b = 0;
     auto v = [&](const auto& vec) { b += vec.capacity() * sizeof(vec[0]); };
     for (const Level& L : mLevels) {
-        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.mirror), v(L.a.val), v(L.lowVal), v(L.dinv);
+        v(L.a.start), v(L.a.cols), v(L.a.diag), v(L.a.val), v(L.dval), v(L.dinv);
         v(L.colouring.order), v(L.colouring.blockStart), v(L.colouring.colourStart), v(L.visit);
-        v(L.nullB), v(L.dead), v(L.agg.nodeAgg), v(L.agg.memberStart), v(L.agg.members);
-        v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot), v(L.Q);
+        v(L.dead), v(L.graphStart), v(L.graphCols), v(L.agg.nodeAgg), v(L.agg.memberStart),
+            v(L.agg.members);
+        v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot);
         v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
         v(L.r), v(L.x), v(L.t);
     }
-    v(mPartial), v(mOrder), v(mSrcSlot), v(mKind), v(mNormal), v(mPositions);
-    b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double);
+    v(mPartial), v(mSrcSlot), v(mConstrainedRows), v(mKind), v(mNormal), v(mPositions);
+    b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double); // and its factor
     return b;
 }
 
@@ -499,27 +524,35 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         while (!plain && mLevels.back().a.n > mSettings.coarsest &&
                buildCoarse(static_cast<int>(mLevels.size()) - 1)) {
         }
+        for (Level& L : mLevels) { // the node graphs were for the patterns only
+            std::vector<int>().swap(L.graphStart);
+            std::vector<int>().swap(L.graphCols);
+        }
     }
-    // Level 0: Â = S A S + I − S.
+    mSource = &A;
+    // Level 0: Â = S A S + I − S, in single precision (the smoother's, the set-up's and the
+    // single-precision CG products' copy). One pass over A, rows in parallel, with the
+    // finiteness check.
     BsrMatrix& a = mLevels[0].a;
     const int n = a.n;
-    // One pass over A, rows in parallel: the double copy in level-0 order, its single-precision
-    // twin for the smoother and the CG products, and the finiteness check.
-    std::vector<float>& low = mLevels[0].lowVal;
-    low.resize(a.val.size());
+    std::vector<float>& low = a.val;
     std::fill(low.end() - kBsrPad, low.end(), 0.0f);
+    std::vector<double>& dval = mLevels[0].dval;
+    if (plain)
+        dval.resize(a.val.size(), 0.0);
+    else
+        std::vector<double>().swap(dval);
     std::atomic<uint32_t> anyBad{0};
     parallelChunks(static_cast<size_t>(n), 256, [&](size_t i0, size_t i1) {
         const double* __restrict src = A.values();
-        double* __restrict dst = a.val.data();
         float* __restrict lo = low.data();
         const int k0 = a.start[i0], k1 = a.start[i1];
         for (int k = k0; k < k1; ++k) {
             const double* s = src + 9 * static_cast<size_t>(mSrcSlot[k]);
-            for (int q = 0; q < 9; ++q) {
-                dst[9 * static_cast<size_t>(k) + q] = s[q];
+            for (int q = 0; q < 9; ++q)
                 lo[9 * static_cast<size_t>(k) + q] = static_cast<float>(s[q]);
-            }
+            if (plain)
+                for (int q = 0; q < 9; ++q) dval[9 * static_cast<size_t>(k) + q] = s[q];
         }
         // Finite, checked on the single-precision copy (an all-ones exponent: inf or NaN — or
         // a value beyond float range, which the smoother could not use either); integer bit
@@ -533,37 +566,65 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         if (bad) anyBad.fetch_or(1u, std::memory_order_relaxed);
     });
     if (anyBad.load()) return false;
-    auto lower = [&](int k) {
-        for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
-            low[q] = static_cast<float>(a.val[q]);
-    };
     mKind.clear();
+    mConstrainedRows.clear();
+    mNormal.clear();
     if (!constrained.empty()) {
         mKind.assign(n, 0);
-        mNormal.assign(3 * static_cast<size_t>(n), 0.0);
         for (int v : constrained) { // A's row v is level-0 row visit[v]
             const int i = mLevels[0].visit[v];
             mKind[i] = cons.kind[v];
-            for (int q = 0; q < 3; ++q) mNormal[3 * i + q] = cons.normal[3 * v + q];
+            if (mKind[i]) mConstrainedRows.push_back(i);
         }
+        std::sort(mConstrainedRows.begin(), mConstrainedRows.end());
+        mConstrainedRows.erase(std::unique(mConstrainedRows.begin(), mConstrainedRows.end()),
+                               mConstrainedRows.end());
+        mNormal.assign(3 * mConstrainedRows.size(), 0.0); // the normals of those rows only
+        for (size_t c = 0; c < mConstrainedRows.size(); ++c) {
+            const int v = mLevels[0].colouring.order[mConstrainedRows[c]];
+            for (int q = 0; q < 3; ++q)
+                mNormal[3 * c + q] = cons.normal[3 * static_cast<size_t>(v) + q];
+        }
+        // Plain aggregation: the double copy filtered in place, row then column, each block
+        // then rounded (the path before issue 26).
+        auto lower = [&](int k) {
+            for (size_t q = 9 * static_cast<size_t>(k); q < 9 * static_cast<size_t>(k) + 9; ++q)
+                low[q] = static_cast<float>(dval[q]);
+        };
         for (int v : constrained) {
+            if (!plain) break;
             const int i = mLevels[0].visit[v];
-            const Mat3 S = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i);
+            const Mat3 S = Constraints::filterOf(mKind[i], normalOf(i));
             for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-                BlockMap row(a.val.data() + 9 * static_cast<size_t>(k));
+                const int kt = slotIn(a, a.cols[k], i);
+                BlockMap row(dval.data() + 9 * static_cast<size_t>(k));
                 row = (S * row).eval();
-                BlockMap col(a.val.data() + 9 * static_cast<size_t>(a.mirror[k]));
+                BlockMap col(dval.data() + 9 * static_cast<size_t>(kt));
                 col = (col * S).eval();
                 lower(k);
-                lower(a.mirror[k]);
+                lower(kt);
             }
-            BlockMap(a.val.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
+            BlockMap(dval.data() + 9 * static_cast<size_t>(a.diag[i])) += Mat3::Identity() - S;
             lower(a.diag[i]);
         }
+        // Smoothed: S_i A_ij S_j (+ I − S_i on the diagonal) from A's double values, rounded
+        // once; the transposed block written as its transpose.
+        for (int v : constrained) {
+            if (plain) break;
+            const int i = mLevels[0].visit[v];
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                const Mat3 b = levelZeroBlock(i, k);
+                storeBlock(a.val.data() + 9 * static_cast<size_t>(k), b);
+                if (a.cols[k] != i)
+                    storeBlock(a.val.data() + 9 * static_cast<size_t>(slotIn(a, a.cols[k], i)),
+                               b.transpose());
+            }
+        }
     }
-    // Coarse levels: each finished (single-precision copy, diagonal inverses), then the next
-    // one's values from it.
+    // Coarse levels: each finished (diagonal inverses), then the next one's values from it;
+    // the near-null spaces and tentative prolongators are scratch, freed on return.
     const bool reuse = keepCoarse && !fresh && kindsBefore == mKind && mHaveCoarse;
+    mPeakBytes = 0;
     if (plain) {
         // Plain aggregation: aggregate on first sight of the pattern, then sum.
         for (int l = 0;; ++l) {
@@ -583,13 +644,18 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
         }
         for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) finishLevel(l);
     } else {
+        std::vector<double> fineB, coarseB, Q;
         for (int l = 0; l < static_cast<int>(mLevels.size()); ++l) {
             finishLevel(l);
             if (reuse) return true; // the coarse levels and the coarsest factorisation as they were
-            if (l + 1 < static_cast<int>(mLevels.size())) coarsenValues(l);
+            if (l + 1 < static_cast<int>(mLevels.size())) {
+                coarsenValues(l, fineB, coarseB, Q);
+                fineB.swap(coarseB);
+            }
         }
     }
     mHaveCoarse = true;
+    mPeakBytes = std::max(mPeakBytes, bytes());
     // The coarsest level: a dense Cholesky factorisation when it is small (it may not be when
     // coarsening stalled, e.g. on uncoupled vertices: then symmetric Gauss–Seidel).
     const BsrMatrix& c = mLevels.back().a;
@@ -598,7 +664,10 @@ bool BlockMultigrid::refresh(const BlockMatrix& A, const Constraints& cons, cons
     mCoarseDense.setZero(3 * c.n, 3 * c.n);
     for (int I = 0; I < c.n; ++I)
         for (int k = c.start[I]; k < c.start[I + 1]; ++k)
-            mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) = ConstBlockMap(c.val.data() + 9 * static_cast<size_t>(k));
+            mCoarseDense.block<3, 3>(3 * I, 3 * c.cols[k]) =
+                mPlain ? ConstBlockMap(mLevels.back().dval.data() + 9 * static_cast<size_t>(k))
+                : mLevels.size() == 1 ? levelZeroBlock(I, k)
+                                      : blockAt(c.val.data() + 9 * static_cast<size_t>(k));
     mCoarseLlt.compute(mCoarseDense);
     mCoarseOk = mCoarseLlt.info() == Eigen::Success;
     return true;
@@ -616,28 +685,25 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
     if (mSettings.gaussSeidel) {
         GaussSeidelSweep g;
         g.pattern = a.pattern();
-        g.val = L.lowVal.data();
-        g.mirror = a.mirror.data();
+        g.val = a.val.data();
         g.dinv = L.dinv.data();
         g.r = r;
         g.x = x;
-        g.t = residual ? L.t.data() : nullptr;
+        g.t = nullptr; // t is pulled afterwards (cycle, cyclePlainCoarse)
         g.forward = forward;
         g.fromZero = fromZero && forward;
         const bool parallel =
             n >= mSettings.parallelRows && L.colouring.colours() >= 2 && arenaConcurrency() >= 2;
         // Colour by colour (reversed for the backward sweep), each colour's blocks of rows in
-        // parallel; sequentially, one sweep over all rows in the same order. In parallel a block
-        // may not push t to earlier rows another block also reaches: t is pulled afterwards,
-        // the same sums in the same order.
-        if (parallel) g.t = nullptr;
+        // parallel; sequentially, one sweep over all rows in the same order. The residual t is
+        // pulled afterwards, row by row: the same sums in the same order as a push would make.
         forEachColour(L.colouring, !forward, parallel, [&](size_t i0, size_t i1) {
             GaussSeidelSweep part = g;
             part.begin = static_cast<int>(i0);
             part.end = static_cast<int>(i1);
             gaussSeidelSweep(part);
         });
-        return parallel && residual && g.fromZero; // t still to pull (the restriction does)
+        return residual && g.fromZero; // t still to pull (the restriction does)
     }
     // Damped block Jacobi: x += ω D⁻¹ (r − A x).
     const double w = mSettings.jacobiWeight;
@@ -659,7 +725,7 @@ bool BlockMultigrid::smooth(int l, bool forward, bool fromZero, bool residual) {
 // Plain aggregation's coarse correction: r_c = P₀ᵀ t, the coarse cycle, x += α P₀ e (P₀ = S P_tent
 // at level 0, P_tent below).
 void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
-    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after a parallel sweep).
+    // Restriction: r_c(I) = Σ_{i∈I} S_i t_i (with t pulled here after the sweep).
     Level& L = mLevels[l];
     Level& C = mLevels[l + 1];
     const BsrMatrix& a = L.a;
@@ -670,10 +736,9 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
             Vec3 s = Vec3::Zero();
             for (int m = L.plainStart[I]; m < L.plainStart[I + 1]; ++m) {
                 const int i = L.plainMembers[m];
-                if (pull) bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i, i + 1);
+                if (pull) bsrUpperResidualRows(p, a.val.data(), L.xp, L.t.data(), i, i + 1);
                 Vec3 t(L.t[3 * i], L.t[3 * i + 1], L.t[3 * i + 2]);
-                if (filtered && mKind[i])
-                    t = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * t;
+                if (filtered && mKind[i]) t = Constraints::filterOf(mKind[i], normalOf(i)) * t;
                 s += t;
             }
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
@@ -686,7 +751,7 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
         for (size_t i = i0; i < i1; ++i) {
             const int I = L.plainAgg[i];
             Vec3 e(C.x[3 * I], C.x[3 * I + 1], C.x[3 * I + 2]);
-            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], mNormal.data() + 3 * i) * e;
+            if (filtered && mKind[i]) e = Constraints::filterOf(mKind[i], normalOf(i)) * e;
             for (int q = 0; q < 3; ++q) L.xp[3 * i + q] += alpha * e[q];
         }
     });
@@ -723,11 +788,11 @@ void BlockMultigrid::cycle(int l) {
         for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
         return;
     }
-    // Restriction r_c = Pᵀ t (t pulled first after a parallel sweep); P's rows lie in range(S).
+    // Restriction r_c = Pᵀ t (t pulled first after the sweep); P's rows lie in range(S).
     if (pull) {
         const BsrPattern p = a.pattern();
         parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
-            bsrUpperResidualRows(p, L.lowVal.data(), L.xp, L.t.data(), i0, i1);
+            bsrUpperResidualRows(p, a.val.data(), L.xp, L.t.data(), i0, i1);
         });
     }
     L.P.restrictTo(L.t.data(), C.r.data());
@@ -737,19 +802,98 @@ void BlockMultigrid::cycle(int l) {
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
 }
 
+const double* BlockMultigrid::normalOf(int i) const {
+    static const double none[3] = {0.0, 0.0, 0.0}; // (the filters of kinds 0 and 1 read none)
+    if (mKind[i] != 2) return none;
+    const size_t c =
+        static_cast<size_t>(std::lower_bound(mConstrainedRows.begin(), mConstrainedRows.end(), i) -
+                            mConstrainedRows.begin());
+    return mNormal.data() + 3 * c;
+}
+
+// Block k of level-0 row i of Â = S A S + I − S in double, from A's values (a one-level
+// hierarchy factors Â itself: an exact solve).
+Mat3 BlockMultigrid::levelZeroBlock(int i, int k) const {
+    const BsrMatrix& a = mLevels[0].a;
+    const int j = a.cols[k];
+    Mat3 b = ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSrcSlot[k]));
+    if (mKind.empty() || !(mKind[i] | mKind[j])) return b;
+    const Mat3 Si = mKind[i] ? Constraints::filterOf(mKind[i], normalOf(i)) : Mat3::Identity();
+    const Mat3 Sj = mKind[j] ? Constraints::filterOf(mKind[j], normalOf(j)) : Mat3::Identity();
+    b = (Si * b * Sj).eval();
+    if (i == j) b += Mat3::Identity() - Si;
+    return b;
+}
+
+// Â x = S A S x + (I − S) x in double from A's values: row p of level 0 is A's row order()[p],
+// its slot k A's slot mSrcSlot[k]; y = A x row by row in level-0 column order, then for each
+// constrained row j (in level order) the columns' part A_ij (S_j − I) x_j added to its
+// neighbours i, then the constrained rows' S_i y_i + (I − S_i) x_i (sequential: few rows).
+void BlockMultigrid::multiply(const double* x, double* y) const {
+    const BsrMatrix& a = mLevels[0].a;
+    if (mPlain) { // the double copy (plain aggregation keeps one)
+        const BsrPattern p = a.pattern();
+        const double* dval = mLevels[0].dval.data();
+        parallelChunks(static_cast<size_t>(a.n), 512,
+                       [&](size_t i0, size_t i1) { bsrMultiplyRows(p, dval, x, y, i0, i1); });
+        return;
+    }
+    const double* __restrict src = mSource->values();
+    parallelChunks(static_cast<size_t>(a.n), 512, [&](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; ++i) {
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+                const double* b = src + 9 * static_cast<size_t>(mSrcSlot[k]);
+                const double* xj = x + 3 * static_cast<size_t>(a.cols[k]);
+                s0 += b[0] * xj[0] + b[3] * xj[1] + b[6] * xj[2];
+                s1 += b[1] * xj[0] + b[4] * xj[1] + b[7] * xj[2];
+                s2 += b[2] * xj[0] + b[5] * xj[1] + b[8] * xj[2];
+            }
+            y[3 * i] = s0;
+            y[3 * i + 1] = s1;
+            y[3 * i + 2] = s2;
+        }
+    });
+    if (mConstrainedRows.empty()) return;
+    const std::vector<int>& start = mSource->blockRowStart();
+    const std::vector<int>& cols = mSource->blockCols();
+    const std::vector<int>& order = mLevels[0].colouring.order;
+    const std::vector<int>& visit = mLevels[0].visit;
+    for (int j : mConstrainedRows) {
+        const Mat3 S = Constraints::filterOf(mKind[j], normalOf(j));
+        const Vec3 d = (S - Mat3::Identity()) * vec3At(x, j);
+        const int v = order[j];
+        for (int k = start[v]; k < start[v + 1]; ++k) // A_uv = (A_vu)ᵀ, the block of row u
+            vec3At(y, visit[cols[k]]) +=
+                ConstBlockMap(mSource->values() + 9 * static_cast<size_t>(mSource->mirrorSlot(k))) *
+                d;
+    }
+    for (int i : mConstrainedRows) {
+        const Mat3 S = Constraints::filterOf(mKind[i], normalOf(i));
+        vec3At(y, i) = (S * vec3At(y, i) + (Mat3::Identity() - S) * vec3At(x, i)).eval();
+    }
+}
+
+double BlockMultigrid::multiplyDot(const double* x, double* y, bool single) {
+    if (single) return mLevels[0].a.multiplyDot(x, y, mPartial);
+    if (mPlain) return mLevels[0].a.multiplyDot(x, y, mPartial, mLevels[0].dval.data());
+    multiply(x, y);
+    return deterministicDot(x, y, 3 * static_cast<size_t>(mLevels[0].a.n));
+}
+
 void BlockMultigrid::toLevelOrder(const double* natural, double* level) const {
-    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+    parallelChunks(order().size(), 2048, [&](size_t p0, size_t p1) {
         for (size_t p = p0; p < p1; ++p)
             for (int q = 0; q < 3; ++q)
-                level[3 * p + q] = natural[3 * static_cast<size_t>(mOrder[p]) + q];
+                level[3 * p + q] = natural[3 * static_cast<size_t>(order()[p]) + q];
     });
 }
 
 void BlockMultigrid::fromLevelOrder(const double* level, double* natural) const {
-    parallelChunks(mOrder.size(), 2048, [&](size_t p0, size_t p1) {
+    parallelChunks(order().size(), 2048, [&](size_t p0, size_t p1) {
         for (size_t p = p0; p < p1; ++p)
             for (int q = 0; q < 3; ++q)
-                natural[3 * static_cast<size_t>(mOrder[p]) + q] = level[3 * p + q];
+                natural[3 * static_cast<size_t>(order()[p]) + q] = level[3 * p + q];
     });
 }
 

@@ -24,20 +24,23 @@ enum class MultigridKind { Automatic, Plain, Smoothed };
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
 // column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
-// zeros (bsr_kernels.h).
+// zeros (bsr_kernels.h). Values in single precision: the multigrid's levels are read by the
+// smoother and the set-up only (conjugate gradient's double-precision products read the
+// assembled matrix itself, BlockMultigrid::multiply).
 struct BsrMatrix {
     int n = 0;
-    std::vector<int> start, cols, diag, mirror; // mirror[k]: slot of the transposed block
-    std::vector<double> val;
+    std::vector<int> start, cols, diag;
+    std::vector<float> val;
 
     int blocks() const { return static_cast<int>(cols.size()); }
     BsrPattern pattern() const { return {start.data(), cols.data(), diag.data(), n}; }
     // y = M x, parallel over rows (deterministic: each row is summed in column order).
     void multiply(const double* x, double* y) const;
     // y = M x and returns xᵀy, summed in chunks of kReduceChunk entries like deterministicDot
-    // (same bits; one pass over x and y instead of two). `partial` is scratch.
-    // With `single` (these values in float), the product reads those instead of val.
-    double multiplyDot(const double* x, double* y, std::vector<double>& partial, const float* single = nullptr) const;
+    // (same bits; one pass over x and y instead of two). `partial` is scratch. With `dval`
+    // (these blocks in double), the product reads those instead of val.
+    double multiplyDot(const double* x, double* y, std::vector<double>& partial,
+                       const double* dval = nullptr) const;
 };
 
 // Smoothed-aggregation AMG (Vaněk, Mandel, Brezina 1996) for the filtered system
@@ -77,9 +80,16 @@ struct BsrMatrix {
 // smoother is nearly as strong as the lexicographic one (bench/README.md). Aggregation visits
 // the rows in their natural order, so the renumbering does not change the aggregates. Vectors
 // passed to apply, multiply and
-// multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder). The smoother reads a
-// single-precision copy of each level's matrix (half the memory traffic; the V-cycle only
-// approximates Â⁻¹ anyway), while conjugate gradient multiplies with Â in double precision.
+// multiplyDot are in this level-0 order (toLevelOrder / fromLevelOrder).
+//
+// Memory (bench/README.md, issue 26 fourth pass): with smoothed aggregation every level and
+// the prolongators are held in single precision only (half the memory traffic; the V-cycle only
+// approximates Â⁻¹ anyway; the set-up reads them and sums in double). Conjugate gradient's
+// double-precision products (multiply, multiplyDot without `single`) read the assembled A
+// itself through the level-0 slot map, filtering on the fly, so no double copy of Â is held.
+// The near-null space and the tentative prolongator are set-up scratch, freed by refresh.
+// Plain aggregation (small meshes) keeps its levels in double too, as before, so that its
+// results stay those of the path before issue 26 bit for bit.
 class BlockMultigrid {
 public:
     struct Settings {
@@ -120,7 +130,8 @@ public:
 
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
     // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false
-    // when a value is not finite.
+    // when a value is not finite. A and c must stay alive and unchanged while the products
+    // below (multiply, multiplyDot in double) are used: they read them.
     // keepCoarse: only level 0 takes A's values; the coarse levels and prolongators stay those
     // of the last full refresh (still an SPD preconditioner, for a matrix that changed little:
     // Newton's iterates, GMRES's repeated solves with one matrix). Ignored when the pattern
@@ -137,13 +148,13 @@ public:
     // z = B r with B ≈ Â⁻¹ symmetric positive definite (one V-cycle from zero, written into z
     // directly; z must not overlap r); returns rᵀz (deterministicDot).
     double apply(const double* r, double* z);
-    // y = Â x with the level-0 copy.
-    void multiply(const double* x, double* y) const { mLevels[0].a.multiply(x, y); }
-    // y = Â x and returns xᵀÂx (deterministicDot's summation order); `single`: with the
-    // single-precision copy of Â (half the memory traffic; see FilteredSolver::solvePcgMultigrid).
-    double multiplyDot(const double* x, double* y, bool single) {
-        return mLevels[0].a.multiplyDot(x, y, mPartial, single ? mLevels[0].lowVal.data() : nullptr);
-    }
+    // y = Â x in double precision: A's values (the last refresh's A) read through the level-0
+    // slot map, Â = S A S + I − S applied on the fly; each row summed in level-0 column order.
+    void multiply(const double* x, double* y) const;
+    // y = Â x and returns xᵀÂx (deterministicDot's summation order); `single`: with level 0's
+    // single-precision Â (half the memory traffic; see FilteredSolver::solvePcgMultigrid),
+    // else as multiply.
+    double multiplyDot(const double* x, double* y, bool single);
 
     int levelCount() const { return static_cast<int>(mLevels.size()); }
     int rows(int level) const { return mLevels[level].a.n; }
@@ -151,39 +162,46 @@ public:
     int modes() const { return mModes; }
     // The hierarchy in use is plain aggregation (Settings::smoothed, smoothedMinRows).
     bool plain() const { return mPlain; }
-    // Bytes held by the hierarchy (matrices, prolongators, work vectors).
+    // Bytes held by the hierarchy between solves (matrices, prolongators, maps, work vectors);
+    // peakBytes: the most held during the last refresh, its scratch included.
     size_t bytes() const;
+    size_t peakBytes() const { return mPeakBytes; }
 
 private:
     struct Level {
-        BsrMatrix a;
-        std::vector<float> lowVal;     // a.val in single precision, read by the smoother
-        std::vector<double> dinv;      // 9 per row: inverse diagonal block
+        BsrMatrix a;                   // in single precision (the smoother's and set-up's copy)
+        std::vector<double> dval;      // plain aggregation only: a's values in double, summed
+                                       // into the next level and read by CG's double products
+                                       // (the path before issue 26, kept bit for bit)
+        std::vector<double> dinv;      // 9 per row: inverse diagonal block (+ kBsrPad), double: the
+                                       // sweep then solves its row to rounding, as the fused
+                                       // residual assumes (the V-cycle stays symmetric)
         ColouredBlocks colouring;      // order[p]: the natural index of row p (types.h)
         std::vector<int> visit;        // row of each natural index (the aggregation's order)
-        std::vector<double> nullB;     // near-null space: 3×modes per row, column-major
         std::vector<uint8_t> dead;     // per scalar unknown: no mode reaches it (coarse levels)
         std::vector<int> graphStart, graphCols; // node graph (colour-order nodes) to aggregate
+                                                // (only while the next level's pattern is built)
         Aggregates agg;                // nodes of this level → nodes of the next (agg.d: rows per node)
         BlockProlongator P;            // to the next level
-        std::vector<double> Q;         // tentative prolongator: 3×modes per row
         // Plain aggregation only (aggregatePlain): the aggregate of each row, the rows of each
         // aggregate, the next level's slot of each slot and its inverse (the slots summed).
         std::vector<int> plainAgg, plainStart, plainMembers, coarseSlot, gatherStart, gather;
-        std::vector<double> r, x, t;   // 3n work vectors
+        std::vector<double> r, x, t;   // 3n work vectors (level 0: t only)
         const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
         double* xp = nullptr;
     };
 
     void buildHierarchy(const BlockMatrix& A);
     bool buildCoarse(int l); // false: coarsening stalls
-    void levelZeroNullSpace();
-    void coarsenValues(int l);
+    void levelZeroNullSpace(std::vector<double>& B) const;
+    Mat3 levelZeroBlock(int i, int k) const; // block k of level-0 row i of Â in double
+    void coarsenValues(int l, std::vector<double>& fineB, std::vector<double>& coarseB,
+                       std::vector<double>& Q);
     void aggregatePlain(Level& fine, Level& coarse);
     void coarsenPlain(int l);
     void finishLevel(int l);
-    // residual: (forward from zero only) also leave t = r − A x in L.t — or, after a parallel
-    // sweep, return true: t is then to be pulled row by row (bsrUpperResidualRows).
+    // residual: (forward from zero only) return true: t = r − A x is then to be pulled into L.t
+    // row by row (bsrUpperResidualRows; no slot map of transposed blocks is kept to push it).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
     void cyclePlainCoarse(int l, bool pull);
@@ -192,11 +210,17 @@ private:
     std::vector<Level> mLevels;
     int mPatternRows = -1, mPatternSlots = -1;
     std::vector<double> mPartial; // chunk sums of the fused dot products
-    std::vector<int> mOrder;      // A's row of each level-0 row
+    const std::vector<int>& order() const {
+        return mLevels[0].colouring.order;
+    }                             // A's row of each level-0 row
     std::vector<int> mSrcSlot;    // A's slot of each level-0 slot
     std::vector<uint8_t> mKind; // level-0 filter kind per row (0 free, 1 full, 2 plane)
-    std::vector<double> mNormal;
+    std::vector<double> mNormal;         // 3 per mConstrainedRows entry
+    const double* normalOf(int i) const; // the plane normal of level-0 row i (kind 2)
     std::vector<double> mPositions; // A's order, for the rotations
+    const BlockMatrix* mSource = nullptr; // the last refresh's A (multiply in double)
+    std::vector<int> mConstrainedRows;    // level-0 rows with S ≠ I, increasing
+    size_t mPeakBytes = 0;
     int mModes = 3;
     bool mPlain = false;
     bool mHaveCoarse = false; // the coarse levels hold values (keepCoarse may reuse them)

@@ -19,6 +19,15 @@ namespace {
 using BlockMap = Eigen::Map<Mat3>;
 using ConstBlockMap = Eigen::Map<const Mat3>;
 
+// A single-precision block (column-major, 9 floats) as a double 3×3 matrix.
+inline Mat3 blockAt(const float* p) {
+    return Eigen::Map<const Eigen::Matrix3f>(p).cast<double>();
+}
+inline void storeBlock(float* p, const Mat3& m) {
+    Eigen::Map<Eigen::Matrix3f> out(p);
+    out = m.cast<float>();
+}
+
 int findSlot(const std::vector<int>& cols, int k0, int k1, int col) {
     for (int k = k0; k < k1; ++k)
         if (cols[k] == col) return k;
@@ -45,27 +54,52 @@ void BlockProlongator::buildTranspose() {
         }
 }
 
+// (Written out in scalars: the float blocks are read once each, without temporaries. The
+// transposed walk reads P's blocks out of storage order, mostly cache misses: the blocks a few
+// steps ahead are prefetched.)
 void BlockProlongator::restrictTo(const double* x, double* y) const {
     parallelChunks(static_cast<size_t>(columns), 256, [&](size_t J0, size_t J1) {
+        const float* __restrict v = val.data();
+        const int ahead = 12, last = tStart[J1];
         for (size_t J = J0; J < J1; ++J) {
-            Vec3 s = Vec3::Zero();
-            for (int t = tStart[J]; t < tStart[J + 1]; ++t)
-                s.noalias() +=
-                    ConstBlockMap(val.data() + 9 * static_cast<size_t>(tSlot[t])).transpose() *
-                    Eigen::Map<const Vec3>(x + 3 * static_cast<size_t>(tRow[t]));
-            Eigen::Map<Vec3>(y + 3 * J) = s;
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (int t = tStart[J]; t < tStart[J + 1]; ++t) {
+                if (t + ahead < last) {
+                    const float* p = v + 9 * static_cast<size_t>(tSlot[t + ahead]);
+                    __builtin_prefetch(p);
+                    __builtin_prefetch(p + 8);
+                    __builtin_prefetch(x + 3 * static_cast<size_t>(tRow[t + ahead]));
+                }
+                const float* b =
+                    v + 9 * static_cast<size_t>(tSlot[t]); // column-major: column c of P_rJ
+                const double* xr =
+                    x + 3 * static_cast<size_t>(tRow[t]); // is row c of its transpose
+                s0 += double(b[0]) * xr[0] + double(b[1]) * xr[1] + double(b[2]) * xr[2];
+                s1 += double(b[3]) * xr[0] + double(b[4]) * xr[1] + double(b[5]) * xr[2];
+                s2 += double(b[6]) * xr[0] + double(b[7]) * xr[1] + double(b[8]) * xr[2];
+            }
+            y[3 * J] = s0;
+            y[3 * J + 1] = s1;
+            y[3 * J + 2] = s2;
         }
     });
 }
 
 void BlockProlongator::prolongAdd(const double* e, double alpha, double* x) const {
     parallelChunks(static_cast<size_t>(rows), 512, [&](size_t r0, size_t r1) {
+        const float* __restrict v = val.data();
         for (size_t r = r0; r < r1; ++r) {
-            Vec3 s = Vec3::Zero();
-            for (int k = start[r]; k < start[r + 1]; ++k)
-                s.noalias() += ConstBlockMap(val.data() + 9 * static_cast<size_t>(k)) *
-                               Eigen::Map<const Vec3>(e + 3 * static_cast<size_t>(cols[k]));
-            Eigen::Map<Vec3>(x + 3 * r) += alpha * s;
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (int k = start[r]; k < start[r + 1]; ++k) {
+                const float* b = v + 9 * static_cast<size_t>(k);
+                const double* ec = e + 3 * static_cast<size_t>(cols[k]);
+                s0 += double(b[0]) * ec[0] + double(b[3]) * ec[1] + double(b[6]) * ec[2];
+                s1 += double(b[1]) * ec[0] + double(b[4]) * ec[1] + double(b[7]) * ec[2];
+                s2 += double(b[2]) * ec[0] + double(b[5]) * ec[1] + double(b[8]) * ec[2];
+            }
+            x[3 * r] += alpha * s0;
+            x[3 * r + 1] += alpha * s1;
+            x[3 * r + 2] += alpha * s2;
         }
     });
 }
@@ -209,7 +243,9 @@ void prolongatorPattern(const BsrMatrix& A, const Aggregates& g, int dc, bool sm
         P.cols.insert(P.cols.end(), row.begin(), row.end());
         P.start[r + 1] = static_cast<int>(P.cols.size());
     }
-    P.val.assign(9 * P.cols.size(), 0.0);
+    P.cols.shrink_to_fit();
+    P.val.assign(9 * P.cols.size(), 0.0f);
+    P.val.shrink_to_fit();
 }
 
 void smoothProlongator(const BsrMatrix& A, const Aggregates& g, int dc, double omega,
@@ -217,32 +253,34 @@ void smoothProlongator(const BsrMatrix& A, const Aggregates& g, int dc, double o
     const int d = g.d;
     const size_t stride = 9 * static_cast<size_t>(dc);
     parallelChunks(static_cast<size_t>(A.n), 256, [&](size_t r0, size_t r1) {
+        std::vector<double> row; // the row's blocks in double, rounded to float when complete
         for (size_t r = r0; r < r1; ++r) {
             const int k0 = P.start[r], k1 = P.start[r + 1];
-            std::fill(P.val.begin() + 9 * static_cast<size_t>(k0),
-                      P.val.begin() + 9 * static_cast<size_t>(k1), 0.0);
+            row.assign(9 * static_cast<size_t>(k1 - k0), 0.0);
             if (omega == 0.0) {
                 const int U = g.nodeAgg[r / d];
                 for (int q = 0; q < dc; ++q) {
                     const int slot = findSlot(P.cols, k0, k1, U * dc + q);
-                    BlockMap(P.val.data() + 9 * static_cast<size_t>(slot)) =
+                    BlockMap(row.data() + 9 * static_cast<size_t>(slot - k0)) =
                         ConstBlockMap(Q.data() + stride * r + 9 * q);
                 }
-                continue;
-            }
-            const Mat3 dinv = invertBlockOrScale(
-                ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(A.diag[r])));
-            for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
-                const int s = A.cols[k];
-                Mat3 M = -omega * dinv * ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(k));
-                if (s == static_cast<int>(r)) M += Mat3::Identity();
-                const int U = g.nodeAgg[s / d];
-                for (int q = 0; q < dc; ++q) {
-                    const int slot = findSlot(P.cols, k0, k1, U * dc + q);
-                    BlockMap(P.val.data() + 9 * static_cast<size_t>(slot)).noalias() +=
-                        M * ConstBlockMap(Q.data() + stride * s + 9 * q);
+            } else {
+                const Mat3 dinv =
+                    invertBlockOrScale(blockAt(A.val.data() + 9 * static_cast<size_t>(A.diag[r])));
+                for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
+                    const int s = A.cols[k];
+                    Mat3 M = -omega * dinv * blockAt(A.val.data() + 9 * static_cast<size_t>(k));
+                    if (s == static_cast<int>(r)) M += Mat3::Identity();
+                    const int U = g.nodeAgg[s / d];
+                    for (int q = 0; q < dc; ++q) {
+                        const int slot = findSlot(P.cols, k0, k1, U * dc + q);
+                        BlockMap(row.data() + 9 * static_cast<size_t>(slot - k0)).noalias() +=
+                            M * ConstBlockMap(Q.data() + stride * s + 9 * q);
+                    }
                 }
             }
+            for (size_t q = 0; q < row.size(); ++q)
+                P.val[9 * static_cast<size_t>(k0) + q] = static_cast<float>(row[q]);
         }
     });
 }
@@ -269,7 +307,7 @@ double spectralRadiusDinvA(const BsrMatrix& A, const double* dinv, int iteration
     parallelChunks(static_cast<size_t>(A.n), 1024, [&](size_t i0, size_t i1) {
         for (size_t i = i0; i < i1; ++i)
             Eigen::Map<Vec3>(y.data() + 3 * i) =
-                ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(A.diag[i])) *
+                blockAt(A.val.data() + 9 * static_cast<size_t>(A.diag[i])) *
                 Eigen::Map<const Vec3>(x.data() + 3 * i);
     });
     const double den = deterministicDot(x.data(), y.data(), n3);
@@ -307,26 +345,27 @@ void galerkinPattern(const BsrMatrix& A, const BlockProlongator& P, std::vector<
 }
 
 // Row J of C = Pᵀ (A P): Y_s = Σ_r P_rJᵀ A_rs over the fine rows r of column J of P (in
-// increasing order), then C_JK = Σ_s Y_s P_sK over the s in the order first reached. Scratch
-// per thread (its contents never outlive a row). Then C is made exactly symmetric (the two
-// triangles are summed in different orders): C_JK, C_KJ ← their mean.
+// increasing order), then C_JK = Σ_s Y_s P_sK for K ≥ J only, over the s in the order first
+// reached, in double. The row's diagonal block is symmetrised (its two triangles are summed in
+// different orders), each block rounded to float; then each row copies its blocks left of the
+// diagonal as the transposes of those (C is symmetric exactly). Scratch per thread (its
+// contents never outlive a row).
 void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C) {
     parallelChunks(static_cast<size_t>(C.n), 16, [&](size_t J0, size_t J1) {
         thread_local std::vector<int> pos, cpos, touched;
-        thread_local std::vector<double> Y;
+        thread_local std::vector<double> Y, row;
         if (pos.size() < static_cast<size_t>(A.n)) pos.resize(A.n, -1);
         if (cpos.size() < static_cast<size_t>(C.n)) cpos.resize(C.n, -1);
         for (size_t J = J0; J < J1; ++J) {
-            for (int m = C.start[J]; m < C.start[J + 1]; ++m) {
-                cpos[C.cols[m]] = m;
-                std::fill_n(C.val.data() + 9 * static_cast<size_t>(m), 9, 0.0);
-            }
+            const int d0 = C.diag[J], k1 = C.start[J + 1];
+            for (int m = d0; m < k1; ++m) cpos[C.cols[m]] = m - d0;
+            row.assign(9 * static_cast<size_t>(k1 - d0), 0.0);
             touched.clear();
             Y.clear();
             for (int t = P.tStart[J]; t < P.tStart[J + 1]; ++t) {
                 const int r = P.tRow[t];
                 const Mat3 Wt =
-                    ConstBlockMap(P.val.data() + 9 * static_cast<size_t>(P.tSlot[t])).transpose();
+                    blockAt(P.val.data() + 9 * static_cast<size_t>(P.tSlot[t])).transpose();
                 for (int k = A.start[r]; k < A.start[r + 1]; ++k) {
                     const int s = A.cols[k];
                     if (pos[s] < 0) {
@@ -335,30 +374,42 @@ void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C)
                         Y.resize(Y.size() + 9, 0.0);
                     }
                     BlockMap(Y.data() + 9 * static_cast<size_t>(pos[s])).noalias() +=
-                        Wt * ConstBlockMap(A.val.data() + 9 * static_cast<size_t>(k));
+                        Wt * blockAt(A.val.data() + 9 * static_cast<size_t>(k));
                 }
             }
             for (size_t idx = 0; idx < touched.size(); ++idx) {
                 const int s = touched[idx];
                 const ConstBlockMap Ys(Y.data() + 9 * idx);
-                for (int m = P.start[s]; m < P.start[s + 1]; ++m)
-                    BlockMap(C.val.data() + 9 * static_cast<size_t>(cpos[P.cols[m]])).noalias() +=
-                        Ys * ConstBlockMap(P.val.data() + 9 * static_cast<size_t>(m));
+                // P's columns are sorted: those from J on.
+                const int* c0 = P.cols.data() + P.start[s];
+                const int* c1 = P.cols.data() + P.start[s + 1];
+                for (const int* c = std::lower_bound(c0, c1, static_cast<int>(J)); c < c1; ++c) {
+                    const size_t m = static_cast<size_t>(c - P.cols.data());
+                    BlockMap(row.data() + 9 * static_cast<size_t>(cpos[*c])).noalias() +=
+                        Ys * blockAt(P.val.data() + 9 * m);
+                }
                 pos[s] = -1;
             }
-            for (int m = C.start[J]; m < C.start[J + 1]; ++m) cpos[C.cols[m]] = -1;
+            for (int m = d0; m < k1; ++m) {
+                Mat3 b = ConstBlockMap(row.data() + 9 * static_cast<size_t>(m - d0));
+                if (m == d0) b = (0.5 * (b + b.transpose())).eval();
+                storeBlock(C.val.data() + 9 * static_cast<size_t>(m), b);
+                cpos[C.cols[m]] = -1;
+            }
         }
     });
-    // Symmetrise: each row writes its diagonal and its blocks right of the diagonal together
-    // with their mirrors (rows below): no two rows write the same slot.
-    parallelChunks(static_cast<size_t>(C.n), 256, [&](size_t J0, size_t J1) {
-        for (size_t J = J0; J < J1; ++J)
-            for (int m = C.diag[J]; m < C.start[J + 1]; ++m) {
-                BlockMap a(C.val.data() + 9 * static_cast<size_t>(m));
-                BlockMap b(C.val.data() + 9 * static_cast<size_t>(C.mirror[m]));
-                const Mat3 s = 0.5 * (a + b.transpose());
-                a = s;
-                b = s.transpose();
+    parallelChunks(static_cast<size_t>(C.n), 256, [&](size_t K0, size_t K1) {
+        for (size_t K = K0; K < K1; ++K)
+            for (int m = C.start[K]; m < C.diag[K]; ++m) {
+                const int J = C.cols[m];
+                const int* c0 = C.cols.data() + C.diag[J];
+                const int* c1 = C.cols.data() + C.start[J + 1];
+                const size_t mt = static_cast<size_t>(
+                    std::lower_bound(c0, c1, static_cast<int>(K)) - C.cols.data());
+                const float* src = C.val.data() + 9 * mt;
+                float* dst = C.val.data() + 9 * static_cast<size_t>(m);
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) dst[3 * c + r] = src[3 * r + c];
             }
     });
 }

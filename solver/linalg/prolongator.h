@@ -15,7 +15,7 @@ struct BsrMatrix;
 struct BlockProlongator {
     int rows = 0, columns = 0;
     std::vector<int> start, cols;         // block CSR by rows, columns sorted
-    std::vector<double> val;              // 9 per block, column-major
+    std::vector<float> val;               // 9 per block, column-major, single precision
     std::vector<int> tStart, tRow, tSlot; // column J: rows tRow[tStart[J] ..] (increasing), slots
 
     void buildTranspose();
@@ -57,7 +57,7 @@ void prolongatorPattern(const BsrMatrix& A, const Aggregates& g, int dc, bool sm
                         BlockProlongator& P);
 
 // P = (I − ω D⁻¹ A) P_tent (Vaněk et al. 1996, eq. 3.4; D the 3×3 block diagonal of A), or
-// P = P_tent with ω = 0; rows in parallel.
+// P = P_tent with ω = 0; rows in parallel, each summed in double and stored in float.
 void smoothProlongator(const BsrMatrix& A, const Aggregates& g, int dc, double omega,
                        const std::vector<double>& Q, BlockProlongator& P);
 
@@ -69,8 +69,10 @@ double spectralRadiusDinvA(const BsrMatrix& A, const double* dinv, int iteration
 // P.columns rows.
 void galerkinPattern(const BsrMatrix& A, const BlockProlongator& P, std::vector<int>& start,
                      std::vector<int>& cols);
-// C's values (its pattern from galerkinPattern, diag/mirror set): coarse rows in parallel, each
-// summed in a fixed order (the same bits for any thread count).
+// C's values (its pattern from galerkinPattern, diag set): coarse rows in parallel, each
+// summed in double in a fixed order (the same bits for any thread count); row J computes its
+// diagonal and the blocks right of it, the blocks left of the diagonal are copied as their
+// transposes, so C is symmetric exactly; stored in float.
 void galerkinValues(const BsrMatrix& A, const BlockProlongator& P, BsrMatrix& C);
 
 } // namespace gale::solver
