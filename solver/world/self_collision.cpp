@@ -41,6 +41,11 @@ constexpr int kChunk = 64;         // primitives per parallel chunk (results ord
 constexpr int kRebuildEvery = 8;   // passes between tree rebuilds (refits in between)
 // Candidates stay valid while no vertex moves more than this × ξ from where they were gathered.
 constexpr double kMoveAllowance = 0.5;
+// A re-gather queries only the moved vertices' primitives while at most 1/kRegatherShare of the
+// vertices moved beyond the allowance (ensureCandidates).
+constexpr size_t kRegatherShare = 8;
+// Relative margin of the early outs on box distances (far above the 1e-15 rounding of distances).
+constexpr double kBoundMargin = 1e-6;
 // Proximity: the fraction of the way back to ξ a pair already closer at the start is eased per
 // substep.
 constexpr double kEase = 0.25;
@@ -165,13 +170,13 @@ void SelfCollision::scatter() {
     }
 }
 
-void SelfCollision::refitBoxes(bool swept, double inflate) {
+void SelfCollision::refitBoxes(const std::vector<double>& x1, bool swept, double inflate) {
     // Boxes of vertices, triangles and edges over the step (or at x₁), each inflated by
     // `inflate`: overlapping boxes cover every pair within 2·inflate.
     const auto boxOf = [&](const int* v, int count) {
         Box b;
         for (int k = 0; k < count; ++k) {
-            b.add(Vec3(vec3At(mX1.data(), v[k])));
+            b.add(Vec3(vec3At(x1.data(), v[k])));
             if (swept) b.add(Vec3(vec3At(mX0.data(), v[k])));
         }
         b.inflate(inflate);
@@ -207,36 +212,49 @@ double SelfCollision::pairThickness(const Pair& p) const {
 
 // Vertex–triangle pairs (v, a, b, c) and edge–edge pairs (p, q, r, s) whose boxes (refitBoxes)
 // overlap, the primitives sharing no vertex and not all held; α left to the narrow phase. One
-// simultaneous descent of two trees each (bvh.h), the two kinds side by side; the order of the
-// pairs depends only on the trees.
+// simultaneous descent of two trees each (bvh.h), split into parts that run in parallel, each
+// into its own list, concatenated in the walk's order: the pairs and their order depend only on
+// the trees, not on the threads.
 void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>& eeOut) const {
     const auto held = [&](int a, int b, int c, int d) {
         return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
     };
-    tbb::parallel_invoke(
-        [&] {
-            vtOut.clear();
-            mVertTree.overlappingPairs(mTriTree, [&](int vi, int t) {
+    constexpr size_t kTasks = 64; // parts per kind (a few per thread, for balance)
+    const std::vector<contact::Bvh::PairTask> vtTasks = mVertTree.pairTasks(mTriTree, kTasks);
+    const std::vector<contact::Bvh::PairTask> eeTasks = mEdgeTree.pairTasks(mEdgeTree, kTasks);
+    std::vector<std::vector<Pair>> parts(vtTasks.size() + eeTasks.size());
+    tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
+        std::vector<Pair>& out = parts[k];
+        if (k < vtTasks.size()) {
+            mVertTree.overlappingPairs(mTriTree, vtTasks[k], [&](int vi, int t) {
                 const auto& tri = mTris[t];
                 if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
                 if (held(vi, tri[0], tri[1], tri[2])) return; // nothing can move
-                vtOut.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
+                out.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
             });
-        },
-        [&] {
-            eeOut.clear();
-            mEdgeTree.overlappingPairs(mEdgeTree, [&](int e, int f) {
-                const auto& ea = mEdges[e];
-                const auto& eb = mEdges[f];
-                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
-                if (held(ea[0], ea[1], eb[0], eb[1])) return;
-                // Strand against strand (hair has no triangles): not modelled.
-                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
-                    !mBodyHasTriangles[mVertexBody[eb[0]]])
-                    return;
-                eeOut.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
-            });
+            return;
+        }
+        mEdgeTree.overlappingPairs(mEdgeTree, eeTasks[k - vtTasks.size()], [&](int e, int f) {
+            const auto& ea = mEdges[e];
+            const auto& eb = mEdges[f];
+            if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
+            if (held(ea[0], ea[1], eb[0], eb[1])) return;
+            // Strand against strand (hair has no triangles): not modelled.
+            if (!mBodyHasTriangles[mVertexBody[ea[0]]] && !mBodyHasTriangles[mVertexBody[eb[0]]])
+                return;
+            out.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
         });
+    });
+    const auto concatenate = [&](size_t begin, size_t end, std::vector<Pair>& all) {
+        size_t total = 0;
+        for (size_t k = begin; k < end; ++k) total += parts[k].size();
+        all.clear();
+        all.reserve(total);
+        for (size_t k = begin; k < end; ++k)
+            all.insert(all.end(), parts[k].begin(), parts[k].end());
+    };
+    concatenate(0, vtTasks.size(), vtOut);
+    concatenate(vtTasks.size(), parts.size(), eeOut);
 }
 
 double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) const {
@@ -254,6 +272,26 @@ double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) co
         side = std::max(side, (d[k] - mean).norm());
     }
     return (la + lb) * (1.0 + 1e-12);
+}
+
+double SelfCollision::boxGap(const std::vector<double>& x, const Pair& p,
+                             bool vertexTriangle) const {
+    // The two primitives' boxes at x and the distance between them: the closest points lie in
+    // the boxes, so no pair of points is closer.
+    const int first = vertexTriangle ? 1 : 2;
+    Vec3 loA = vec3At(x.data(), p.v[0]), hiA = loA;
+    Vec3 loB = vec3At(x.data(), p.v[first]), hiB = loB;
+    for (int k = 1; k < first; ++k) {
+        const Vec3 y = vec3At(x.data(), p.v[k]);
+        loA = loA.cwiseMin(y);
+        hiA = hiA.cwiseMax(y);
+    }
+    for (int k = first + 1; k < 4; ++k) {
+        const Vec3 y = vec3At(x.data(), p.v[k]);
+        loB = loB.cwiseMin(y);
+        hiB = hiB.cwiseMax(y);
+    }
+    return (loA - hiB).cwiseMax(loB - hiA).cwiseMax(0.0).norm();
 }
 
 bool SelfCollision::adjacent(int a, int b) const {
@@ -352,23 +390,111 @@ bool SelfCollision::ensureCandidates() {
     // inflated by ξ on each side then still cover every pair within ξ (proximity) or whose path
     // comes within ξ_c ≤ ξ (CCD), since each box has grown by at most δ per side.
     const double delta = kMoveAllowance * mMaxThickness;
+    const size_t n = mX1.size() / 3;
     if (mCandidatesValid) {
-        double moved2 = 0.0;
-        for (size_t i = 0; i < mX1.size() / 3; ++i)
-            moved2 = std::max(
-                moved2, (Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i))).squaredNorm());
-        if (moved2 <= delta * delta) return false;
+        std::vector<uint8_t> moved(n, 0);
+        size_t count = 0;
+        for (size_t i = 0; i < n; ++i)
+            if ((Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i))).squaredNorm() >
+                delta * delta) {
+                moved[i] = 1;
+                ++count;
+            }
+        if (count == 0) return false;
+        // A CCD correction moves the few vertices of the pairs it hit: re-query only those
+        // (the pairs of the others are still covered). When many moved, gather afresh.
+        if (count * kRegatherShare <= n) {
+            const auto t0 = std::chrono::steady_clock::now();
+            regatherMoved(moved);
+            mMaybeValid = false;
+            ++mStats.broadPhases;
+            mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
+            mStats.broadSeconds += seconds(t0);
+            return true;
+        }
     }
     const auto t0 = std::chrono::steady_clock::now();
-    refitBoxes(true, (0.5 + kMoveAllowance) * mMaxThickness);
-    gatherCandidates(mCandVt, mCandEe);
     mXc = mX1;
+    refitBoxes(mXc, true, (0.5 + kMoveAllowance) * mMaxThickness);
+    gatherCandidates(mCandVt, mCandEe);
     mCandidatesValid = true;
     mMaybeValid = false;
     ++mStats.broadPhases;
     mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
     mStats.broadSeconds += seconds(t0);
     return true;
+}
+
+void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
+    // Why the kept pairs still cover: every vertex v now has a reference x_c(v) it is within δ
+    // of (its old one, or its x₁ now if it moved beyond), and the boxes are over x₀ → x_c,
+    // inflated by ξ/2 + δ, exactly as at a full gathering (ensureCandidates). A pair of unmoved
+    // vertices has the same boxes as when it was gathered, so it is in the old list exactly
+    // when its boxes overlap; a pair with a moved vertex is found by a query of the moved
+    // primitive's new box. The boxes of all primitives are refreshed (unmoved ones unchanged).
+    const size_t n = moved.size();
+    for (size_t i = 0; i < n; ++i)
+        if (moved[i]) vec3At(mXc.data(), i) = vec3At(mX1.data(), i);
+    refitBoxes(mXc, true, (0.5 + kMoveAllowance) * mMaxThickness);
+    const auto touches = [&](const Pair& p) {
+        return moved[p.v[0]] || moved[p.v[1]] || moved[p.v[2]] || moved[p.v[3]];
+    };
+    mCandVt.erase(std::remove_if(mCandVt.begin(), mCandVt.end(), touches), mCandVt.end());
+    mCandEe.erase(std::remove_if(mCandEe.begin(), mCandEe.end(), touches), mCandEe.end());
+    const auto held = [&](int a, int b, int c, int d) {
+        return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
+    };
+    // Vertex–triangle: the moved vertices against every triangle, then the triangles with a
+    // moved corner against the unmoved vertices (each new pair once).
+    std::vector<int> movedVerts, movedTris, movedEdges;
+    for (size_t i = 0; i < n; ++i)
+        if (moved[i]) movedVerts.push_back(static_cast<int>(i));
+    for (size_t t = 0; t < mTris.size(); ++t)
+        if (moved[mTris[t][0]] || moved[mTris[t][1]] || moved[mTris[t][2]])
+            movedTris.push_back(static_cast<int>(t));
+    std::vector<uint8_t> edgeMoved(mEdges.size(), 0);
+    for (size_t e = 0; e < mEdges.size(); ++e)
+        if (moved[mEdges[e][0]] || moved[mEdges[e][1]]) {
+            edgeMoved[e] = 1;
+            movedEdges.push_back(static_cast<int>(e));
+        }
+    const auto vertexTriangle = [&](int vi, int t, std::vector<Pair>& out) {
+        const auto& tri = mTris[t];
+        if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
+        if (held(vi, tri[0], tri[1], tri[2])) return;
+        out.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
+    };
+    const size_t nv = movedVerts.size(), nt = movedTris.size();
+    const std::vector<Pair> vt =
+        parallelCollect<Pair>(nv + nt, [&](size_t k, std::vector<Pair>& out) {
+            if (k < nv) {
+                const int vi = movedVerts[k];
+                mTriTree.queryEach(mVertBoxes[vi], [&](int t) { vertexTriangle(vi, t, out); });
+                return;
+            }
+            const int t = movedTris[k - nv];
+            mVertTree.queryEach(mTriBoxes[t], [&](int vi) {
+                if (!moved[vi]) vertexTriangle(vi, t, out);
+            });
+        });
+    mCandVt.insert(mCandVt.end(), vt.begin(), vt.end());
+    // Edge–edge: each moved edge against every edge; a pair of two moved edges from the lower.
+    const std::vector<Pair> ee =
+        parallelCollect<Pair>(movedEdges.size(), [&](size_t k, std::vector<Pair>& out) {
+            const int e = movedEdges[k];
+            const auto& ea = mEdges[e];
+            mEdgeTree.queryEach(mEdgeBoxes[e], [&](int f) {
+                if (edgeMoved[f] && f <= e) return;
+                const auto& eb = mEdges[f];
+                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
+                if (held(ea[0], ea[1], eb[0], eb[1])) return;
+                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
+                    !mBodyHasTriangles[mVertexBody[eb[0]]])
+                    return;
+                out.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
+            });
+        });
+    mCandEe.insert(mCandEe.end(), ee.begin(), ee.end());
 }
 
 int SelfCollision::proximity() {
@@ -385,10 +511,14 @@ int SelfCollision::proximity() {
         std::vector<Contact> found =
             parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& out) {
                 Pair p = cands[c];
-                double d1 = 0.0, d0 = 0.0;
-                const Vec3 r1 = closestPair(mX1, p, vt, d1);
                 const double xi = pairThickness(p);
                 const double l = relativeMotionBound(p, vt);
+                // Early out: the boxes' distance g ≤ d₁, so g − l > ξ (with a margin far above
+                // the rounding of either distance) means d₁ − l > ξ > ξ_c: no contact and
+                // nothing for CCD — what the exact distance below would decide.
+                if (boxGap(mX1, p, vt) - l > xi * (1.0 + kBoundMargin)) return;
+                double d1 = 0.0, d0 = 0.0;
+                const Vec3 r1 = closestPair(mX1, p, vt, d1);
                 if (!(d1 - l > mSettings.ccdFraction * xi)) maybe[c] = 1;
                 // Within ξ at the end, or at the start (d₀ ≥ d₁ − l): a pair in resting contact
                 // keeps its side and normal from x₀ even when the step would take it through.
@@ -454,6 +584,10 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
                 const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
                 const double xiC = mSettings.ccdFraction * pairThickness(p);
+                // Early out as in proximity: the boxes' distance at x₀ bounds d₀ from below, so
+                // this is the cheap rejection below (not touching, d₀ − l > ξ_c) decided sooner.
+                const double l = relativeMotionBound(p, vt);
+                if (boxGap(mX0, p, vt) - l > xiC * (1.0 + kBoundMargin)) return;
                 double d0 = 0.0;
                 closestPair(mX0, p, vt, d0);
                 if (!(d0 > kTouching)) {
@@ -462,7 +596,7 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 }
                 // Cheap rejection: the distance at x₀ less the largest relative displacement stays
                 // above the CCD thickness (the bound conservative advancement starts from).
-                if (d0 - relativeMotionBound(p, vt) > xiC) return;
+                if (d0 - l > xiC) return;
                 contact::CcdOptions opt;
                 opt.thickness = xiC;
                 opt.shrinkWithinThickness = true;
@@ -716,7 +850,7 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.mX0 = probe.mX1;
     probe.mBuilt = false;
     probe.mStats = SelfCollisionStats();
-    probe.refitBoxes(false, 0.5 * radius);
+    probe.refitBoxes(probe.mX1, false, 0.5 * radius);
     probe.mCandidatesValid = false;
     double best = INFINITY;
     std::vector<Pair> cands[2];

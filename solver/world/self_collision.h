@@ -80,12 +80,18 @@ public:
 private:
     void gather();
     void scatter();
-    void refitBoxes(bool swept, double inflate);
+    // Boxes over x₀ → `x1` (swept) or of `x1` alone, inflated; the trees refitted (or rebuilt).
+    void refitBoxes(const std::vector<double>& x1, bool swept, double inflate);
     void gatherCandidates(std::vector<Pair>& vt, std::vector<Pair>& ee) const;
+    // The candidates again after the vertices marked in `moved` (and only they) moved beyond
+    // the allowance: the pairs of unmoved vertices kept, those with a moved one queried anew.
+    void regatherMoved(const std::vector<uint8_t>& moved);
     bool restClose(const Pair& p, bool vertexTriangle) const;
     bool adjacent(int a, int b) const;
     bool neighbours(const Pair& p, bool vertexTriangle) const;
     double relativeMotionBound(const Pair& p, bool vertexTriangle) const;
+    // A lower bound (m) of the pair's distance at positions x: the gap between its boxes.
+    double boxGap(const std::vector<double>& x, const Pair& p, bool vertexTriangle) const;
     int proximity();
     // One CCD detection over the step (and, with `apply`, the corrections); `zone`: per vertex
     // its rigid impact zone or −1 (pairs inside one zone are skipped).
@@ -116,7 +122,9 @@ private:
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
     contact::Bvh mVertTree, mTriTree, mEdgeTree;
     std::vector<Pair> mCandVt, mCandEe;
-    std::vector<double> mXc; // x₁ when the candidates were gathered
+    // Per vertex, where it was when the candidates were gathered (x₁ then; a vertex's own x₁
+    // when an incremental re-gather re-queried it).
+    std::vector<double> mXc;
     bool mCandidatesValid = false;
     // Per candidate (vertex–triangle, edge–edge): CCD cannot rule it out from the proximity
     // pass's distances (the first CCD round tests these and pairs with moved vertices).
