@@ -130,6 +130,7 @@ void SelfCollision::addBody(Body& body, const std::vector<std::array<int, 3>>& t
         mAdjacencyStart.push_back(static_cast<int>(mAdjacency.size()));
     }
     mBuilt = false;
+    mCandidatesValid = false;
 }
 
 void SelfCollision::gather() {
@@ -170,14 +171,15 @@ void SelfCollision::scatter() {
     }
 }
 
-void SelfCollision::refitBoxes(const std::vector<double>& x1, bool swept, double inflate) {
-    // Boxes of vertices, triangles and edges over the step (or at x₁), each inflated by
-    // `inflate`: overlapping boxes cover every pair within 2·inflate.
+void SelfCollision::refitBoxes(const std::vector<double>& lo, const std::vector<double>& hi,
+                               double inflate) {
+    // Boxes of vertices, triangles and edges: the union of their vertices' boxes [lo, hi],
+    // inflated by `inflate` (overlapping boxes cover every pair within 2·inflate of them).
     const auto boxOf = [&](const int* v, int count) {
         Box b;
         for (int k = 0; k < count; ++k) {
-            b.add(Vec3(vec3At(x1.data(), v[k])));
-            if (swept) b.add(Vec3(vec3At(mX0.data(), v[k])));
+            b.add(Vec3(vec3At(lo.data(), v[k])));
+            b.add(Vec3(vec3At(hi.data(), v[k])));
         }
         b.inflate(inflate);
         return b;
@@ -266,12 +268,14 @@ double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) co
         mean += d[k];
     }
     mean /= 4.0;
+    // The largest squared norm per side, then one square root each (√ is monotonic and
+    // correctly rounded: the same value as the largest of the norms).
     double la = 0.0, lb = 0.0;
     for (int k = 0; k < 4; ++k) {
         double& side = (vertexTriangle ? k < 1 : k < 2) ? la : lb;
-        side = std::max(side, (d[k] - mean).norm());
+        side = std::max(side, (d[k] - mean).squaredNorm());
     }
-    return (la + lb) * (1.0 + 1e-12);
+    return (std::sqrt(la) + std::sqrt(lb)) * (1.0 + 1e-12);
 }
 
 double SelfCollision::boxGap(const std::vector<double>& x, const Pair& p,
@@ -385,24 +389,41 @@ void stopApproach(std::vector<double>& v, const std::vector<double>& invMass,
 }
 } // namespace
 
+void SelfCollision::setRegion(size_t i, double delta) {
+    for (int j = 0; j < 3; ++j) {
+        const double a = mX0[3 * i + j], b = mX1[3 * i + j];
+        mRegionLo[3 * i + j] = std::min(a, b) - delta;
+        mRegionHi[3 * i + j] = std::max(a, b) + delta;
+    }
+}
+
 bool SelfCollision::ensureCandidates() {
-    // Valid while no vertex has moved more than δ = ξ/2 from where they were gathered: boxes
-    // inflated by ξ on each side then still cover every pair within ξ (proximity) or whose path
-    // comes within ξ_c ≤ ξ (CCD), since each box has grown by at most δ per side.
+    // The candidates were gathered over per-vertex regions: the box of the vertex's path
+    // x₀ → x₁ then, grown by δ = ξ/2 (setRegion), each primitive's box the union of its
+    // vertices' regions inflated by ξ/2. While every vertex's path x₀ → x₁ (the straight line
+    // of the step) stays inside its region, so does every primitive's swept box inside its
+    // gathered box, and the candidates still hold every pair within ξ at x₁ (proximity) or
+    // whose path comes within ξ_c ≤ ξ (CCD): after the pass's corrections and in later passes
+    // (a pile at rest keeps its candidates from substep to substep).
     const double delta = kMoveAllowance * mMaxThickness;
     const size_t n = mX1.size() / 3;
     if (mCandidatesValid) {
         std::vector<uint8_t> moved(n, 0);
         size_t count = 0;
         for (size_t i = 0; i < n; ++i)
-            if ((Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i))).squaredNorm() >
-                delta * delta) {
-                moved[i] = 1;
-                ++count;
+            for (int j = 0; j < 3; ++j) {
+                const double lo = mRegionLo[3 * i + j], hi = mRegionHi[3 * i + j];
+                const double a = mX0[3 * i + j], b = mX1[3 * i + j];
+                if (!(a >= lo && a <= hi && b >= lo && b <= hi)) {
+                    moved[i] = 1;
+                    ++count;
+                    break;
+                }
             }
         if (count == 0) return false;
-        // A CCD correction moves the few vertices of the pairs it hit: re-query only those
-        // (the pairs of the others are still covered). When many moved, gather afresh.
+        // A CCD correction moves the few vertices of the pairs it hit, a resting pile only its
+        // few sliding vertices: re-query only those (the pairs of the others are still
+        // covered). When many left their regions, gather afresh.
         if (count * kRegatherShare <= n) {
             const auto t0 = std::chrono::steady_clock::now();
             regatherMoved(moved);
@@ -414,8 +435,10 @@ bool SelfCollision::ensureCandidates() {
         }
     }
     const auto t0 = std::chrono::steady_clock::now();
-    mXc = mX1;
-    refitBoxes(mXc, true, (0.5 + kMoveAllowance) * mMaxThickness);
+    mRegionLo.resize(3 * n);
+    mRegionHi.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) setRegion(i, delta);
+    refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
     gatherCandidates(mCandVt, mCandEe);
     mCandidatesValid = true;
     mMaybeValid = false;
@@ -426,16 +449,15 @@ bool SelfCollision::ensureCandidates() {
 }
 
 void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
-    // Why the kept pairs still cover: every vertex v now has a reference x_c(v) it is within δ
-    // of (its old one, or its x₁ now if it moved beyond), and the boxes are over x₀ → x_c,
-    // inflated by ξ/2 + δ, exactly as at a full gathering (ensureCandidates). A pair of unmoved
-    // vertices has the same boxes as when it was gathered, so it is in the old list exactly
-    // when its boxes overlap; a pair with a moved vertex is found by a query of the moved
-    // primitive's new box. The boxes of all primitives are refreshed (unmoved ones unchanged).
+    // The moved vertices get new regions (the others keep theirs) and every primitive's box is
+    // recomputed from them, exactly as at a full gathering (ensureCandidates). A pair of
+    // unmoved vertices has the same boxes as when it was gathered, so it is in the old list
+    // exactly when they overlap; a pair with a moved vertex is found by a query of the moved
+    // primitive's new box.
     const size_t n = moved.size();
     for (size_t i = 0; i < n; ++i)
-        if (moved[i]) vec3At(mXc.data(), i) = vec3At(mX1.data(), i);
-    refitBoxes(mXc, true, (0.5 + kMoveAllowance) * mMaxThickness);
+        if (moved[i]) setRegion(i, kMoveAllowance * mMaxThickness);
+    refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
     const auto touches = [&](const Pair& p) {
         return moved[p.v[0]] || moved[p.v[1]] || moved[p.v[2]] || moved[p.v[3]];
     };
@@ -792,7 +814,6 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
         std::copy(start[b].data(), start[b].data() + start[b].size(),
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
-    mCandidatesValid = false;
     mLastHits.clear();
     auto t0 = std::chrono::steady_clock::now();
     std::vector<double> before = mX1;
@@ -850,7 +871,7 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.mX0 = probe.mX1;
     probe.mBuilt = false;
     probe.mStats = SelfCollisionStats();
-    probe.refitBoxes(probe.mX1, false, 0.5 * radius);
+    probe.refitBoxes(probe.mX1, probe.mX1, 0.5 * radius);
     probe.mCandidatesValid = false;
     double best = INFINITY;
     std::vector<Pair> cands[2];

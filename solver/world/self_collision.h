@@ -80,8 +80,11 @@ public:
 private:
     void gather();
     void scatter();
-    // Boxes over x₀ → `x1` (swept) or of `x1` alone, inflated; the trees refitted (or rebuilt).
-    void refitBoxes(const std::vector<double>& x1, bool swept, double inflate);
+    // Boxes of the primitives over their vertices' boxes [lo, hi] (3 per vertex each),
+    // inflated; the trees refitted (or rebuilt).
+    void refitBoxes(const std::vector<double>& lo, const std::vector<double>& hi, double inflate);
+    // Vertex i's region: the box of x₀ → x₁ grown by delta.
+    void setRegion(size_t i, double delta);
     void gatherCandidates(std::vector<Pair>& vt, std::vector<Pair>& ee) const;
     // The candidates again after the vertices marked in `moved` (and only they) moved beyond
     // the allowance: the pairs of unmoved vertices kept, those with a moved one queried anew.
@@ -98,8 +101,9 @@ private:
     // `dirty`: per vertex whether it moved since the last round (null: test every candidate).
     int ccdRound(bool apply, std::vector<Pair>* hits, const std::vector<int>* zone = nullptr,
                  const std::vector<uint8_t>* dirty = nullptr);
-    // The pass's candidate pairs (swept boxes inflated by ξ), gathered again only when some
-    // vertex has moved more than ξ/2 since.
+    // The candidate pairs (swept boxes inflated by ξ), kept from pass to pass and gathered
+    // again (in full, or for the vertices that moved) only when some vertex's path leaves its
+    // region.
     bool ensureCandidates(); // true when it gathered them again
     std::vector<uint8_t> dirtySince(const std::vector<double>& before) const;
     bool rigidZone(const std::vector<int>& members) const;
@@ -122,9 +126,8 @@ private:
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
     contact::Bvh mVertTree, mTriTree, mEdgeTree;
     std::vector<Pair> mCandVt, mCandEe;
-    // Per vertex, where it was when the candidates were gathered (x₁ then; a vertex's own x₁
-    // when an incremental re-gather re-queried it).
-    std::vector<double> mXc;
+    // Per vertex, the region (box, 3 lo and 3 hi per vertex) the candidates cover it in.
+    std::vector<double> mRegionLo, mRegionHi;
     bool mCandidatesValid = false;
     // Per candidate (vertex–triangle, edge–edge): CCD cannot rule it out from the proximity
     // pass's distances (the first CCD round tests these and pairs with moved vertices).
