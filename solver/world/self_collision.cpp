@@ -217,22 +217,23 @@ double SelfCollision::pairThickness(const Pair& p) const {
 // simultaneous descent of two trees each (bvh.h), split into parts that run in parallel, each
 // into its own list, concatenated in the walk's order: the pairs and their order depend only on
 // the trees, not on the threads.
-void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>& eeOut) const {
+void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
+                                     std::vector<Candidate>& eeOut) const {
     const auto held = [&](int a, int b, int c, int d) {
         return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
     };
     constexpr size_t kTasks = 64; // parts per kind (a few per thread, for balance)
     const std::vector<contact::Bvh::PairTask> vtTasks = mVertTree.pairTasks(mTriTree, kTasks);
     const std::vector<contact::Bvh::PairTask> eeTasks = mEdgeTree.pairTasks(mEdgeTree, kTasks);
-    std::vector<std::vector<Pair>> parts(vtTasks.size() + eeTasks.size());
+    std::vector<std::vector<Candidate>> parts(vtTasks.size() + eeTasks.size());
     tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
-        std::vector<Pair>& out = parts[k];
+        std::vector<Candidate>& out = parts[k];
         if (k < vtTasks.size()) {
             mVertTree.overlappingPairs(mTriTree, vtTasks[k], [&](int vi, int t) {
                 const auto& tri = mTris[t];
                 if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
                 if (held(vi, tri[0], tri[1], tri[2])) return; // nothing can move
-                out.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
+                out.push_back({vi, tri[0], tri[1], tri[2]});
             });
             return;
         }
@@ -244,10 +245,10 @@ void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>
             // Strand against strand (hair has no triangles): not modelled.
             if (!mBodyHasTriangles[mVertexBody[ea[0]]] && !mBodyHasTriangles[mVertexBody[eb[0]]])
                 return;
-            out.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
+            out.push_back({ea[0], ea[1], eb[0], eb[1]});
         });
     });
-    const auto concatenate = [&](size_t begin, size_t end, std::vector<Pair>& all) {
+    const auto concatenate = [&](size_t begin, size_t end, std::vector<Candidate>& all) {
         size_t total = 0;
         for (size_t k = begin; k < end; ++k) total += parts[k].size();
         all.clear();
@@ -458,8 +459,8 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
     for (size_t i = 0; i < n; ++i)
         if (moved[i]) setRegion(i, kMoveAllowance * mMaxThickness);
     refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
-    const auto touches = [&](const Pair& p) {
-        return moved[p.v[0]] || moved[p.v[1]] || moved[p.v[2]] || moved[p.v[3]];
+    const auto touches = [&](const Candidate& c) {
+        return moved[c[0]] || moved[c[1]] || moved[c[2]] || moved[c[3]];
     };
     mCandVt.erase(std::remove_if(mCandVt.begin(), mCandVt.end(), touches), mCandVt.end());
     mCandEe.erase(std::remove_if(mCandEe.begin(), mCandEe.end(), touches), mCandEe.end());
@@ -480,15 +481,15 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
             edgeMoved[e] = 1;
             movedEdges.push_back(static_cast<int>(e));
         }
-    const auto vertexTriangle = [&](int vi, int t, std::vector<Pair>& out) {
+    const auto vertexTriangle = [&](int vi, int t, std::vector<Candidate>& out) {
         const auto& tri = mTris[t];
         if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
         if (held(vi, tri[0], tri[1], tri[2])) return;
-        out.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
+        out.push_back({vi, tri[0], tri[1], tri[2]});
     };
     const size_t nv = movedVerts.size(), nt = movedTris.size();
-    const std::vector<Pair> vt =
-        parallelCollect<Pair>(nv + nt, [&](size_t k, std::vector<Pair>& out) {
+    const std::vector<Candidate> vt =
+        parallelCollect<Candidate>(nv + nt, [&](size_t k, std::vector<Candidate>& out) {
             if (k < nv) {
                 const int vi = movedVerts[k];
                 mTriTree.queryEach(mVertBoxes[vi], [&](int t) { vertexTriangle(vi, t, out); });
@@ -501,8 +502,8 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
         });
     mCandVt.insert(mCandVt.end(), vt.begin(), vt.end());
     // Edge–edge: each moved edge against every edge; a pair of two moved edges from the lower.
-    const std::vector<Pair> ee =
-        parallelCollect<Pair>(movedEdges.size(), [&](size_t k, std::vector<Pair>& out) {
+    const std::vector<Candidate> ee =
+        parallelCollect<Candidate>(movedEdges.size(), [&](size_t k, std::vector<Candidate>& out) {
             const int e = movedEdges[k];
             const auto& ea = mEdges[e];
             mEdgeTree.queryEach(mEdgeBoxes[e], [&](int f) {
@@ -513,7 +514,7 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
                 if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
                     !mBodyHasTriangles[mVertexBody[eb[0]]])
                     return;
-                out.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
+                out.push_back({ea[0], ea[1], eb[0], eb[1]});
             });
         });
     mCandEe.insert(mCandEe.end(), ee.begin(), ee.end());
@@ -524,7 +525,7 @@ int SelfCollision::proximity() {
     std::vector<Contact> contacts;
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
-        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        const std::vector<Candidate>& cands = vt ? mCandVt : mCandEe;
         // Also which pairs CCD must test (the first round adds those proximity moves): the
         // distance is Lipschitz in t with the relative displacement bound l, so d(t) ≥ d₁ − l
         // and a pair with d₁ − l > ξ_c cannot come within ξ_c during the step.
@@ -532,7 +533,7 @@ int SelfCollision::proximity() {
         maybe.assign(cands.size(), 0);
         std::vector<Contact> found =
             parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& out) {
-                Pair p = cands[c];
+                Pair p{cands[c], {}};
                 const double xi = pairThickness(p);
                 const double l = relativeMotionBound(p, vt);
                 // Early out: the boxes' distance g ≤ d₁, so g − l > ξ (with a margin far above
@@ -588,11 +589,11 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
     std::atomic<long long> touching{0};
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
-        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        const std::vector<Candidate>& cands = vt ? mCandVt : mCandEe;
         const std::vector<uint8_t>* maybe = dirty && mMaybeValid ? &mMaybe[vt ? 0 : 1] : nullptr;
         std::vector<Contact> out =
             parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& hitsOut) {
-                Pair p = cands[c];
+                Pair p{cands[c], {}};
                 // A pair none of whose vertices moved since a round that found it clear, and that
                 // was not hit then, has the same path: still clear.
                 if (dirty && !(maybe && (*maybe)[c]) && !(*dirty)[p.v[0]] && !(*dirty)[p.v[1]] &&
@@ -874,10 +875,11 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.refitBoxes(probe.mX1, probe.mX1, 0.5 * radius);
     probe.mCandidatesValid = false;
     double best = INFINITY;
-    std::vector<Pair> cands[2];
+    std::vector<Candidate> cands[2];
     probe.gatherCandidates(cands[0], cands[1]);
     for (int kind = 0; kind < 2; ++kind)
-        for (Pair p : cands[kind]) {
+        for (const Candidate& c : cands[kind]) {
+            Pair p{c, {}};
             double d = 0.0;
             closestPair(probe.mX1, p, kind == 0, d);
             if (d < best && !probe.restClose(p, kind == 0)) best = d;
