@@ -47,7 +47,7 @@ def foldScene(on):
                   open(FOLD).read())
 
 
-def run(args, build, work, name, text, threads):
+def runGale(args, build, work, name, text, threads):
     """Runs `gale sim` --repeats times; returns (median wall s, median user CPU s, run.json,
     output folder)."""
     path = os.path.join(work, name + ".toml")
@@ -74,7 +74,8 @@ def run(args, build, work, name, text, threads):
 
 def simulate(args, work, name, on, thickness=0.003, substeps=4, threads=2):
     """The cape: (median wall seconds, run.json, output folder)."""
-    wall, _, data, out = run(args, args.build, work, name, scene(on, thickness, substeps), threads)
+    wall, _, data, out = runGale(args, args.build, work, name, scene(on, thickness, substeps),
+                                 threads)
     return wall, data, out
 
 
@@ -119,8 +120,10 @@ def folding(args, work):
     for threads in (2, 1):
         for label, build in builds:
             tag = "%s%d" % (label, threads)
-            off, offCpu, _, _ = run(args, build, work, "foldoff" + tag, foldScene(False), threads)
-            on, onCpu, data, out = run(args, build, work, "foldon" + tag, foldScene(True), threads)
+            off, offCpu, _, _ = runGale(args, build, work, "foldoff" + tag, foldScene(False),
+                                        threads)
+            on, onCpu, data, out = runGale(args, build, work, "foldon" + tag, foldScene(True),
+                                           threads)
             s, _, unresolved, halved = stages(data)
             n, g = passes(data)
             print("| %s | %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %.2f | %.2f | "
@@ -166,16 +169,25 @@ def main():
         if args.only == "fold":
             return
         print("### 64x64 cape in gusts, thickness 3 mm, 4 substeps, 48 frames\n")
-        print("| threads | off s | on s | on / off | broad s | proximity s | ccd s | fail-safe s "
-              "| fail-safe runs | unresolved | rejected substeps |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        print("| build | threads | off s | on s | on / off | off CPU s | on CPU s | on / off CPU "
+              "| broad s | proximity s | ccd s | fail-safe s | fail-safe runs | unresolved "
+              "| rejected substeps | on: pairs |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        builds = [("this", args.build)]
+        if args.baseline:
+            builds.insert(0, ("baseline", args.baseline))
         for threads in (2, 1):
-            off, _, _ = simulate(args, work, "off%d" % threads, False, threads=threads)
-            on, run, _ = simulate(args, work, "on%d" % threads, True, threads=threads)
-            s, runs, unresolved, halved = stages(run)
-            print("| %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f | %.3f | %d | %d | %d |"
-                  % (threads, off, on, on / off, s["broad"], s["proximity"], s["ccd"],
-                     s["fail_safe"], runs, unresolved, halved), flush=True)
+            for label, build in builds:
+                tag = "%s%d" % (label, threads)
+                text = [scene(on, 0.003, 4) for on in (False, True)]
+                off, offCpu, _, _ = runGale(args, build, work, "off" + tag, text[0], threads)
+                on, onCpu, data, out = runGale(args, build, work, "on" + tag, text[1], threads)
+                s, runs, unresolved, halved = stages(data)
+                print("| %s | %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %.2f | %.2f "
+                      "| %.2f | %.3f | %d | %d | %d | %d |"
+                      % (label, threads, off, on, on / off, offCpu, onCpu, onCpu / offCpu,
+                         s["broad"], s["proximity"], s["ccd"], s["fail_safe"], runs, unresolved,
+                         halved, pairs(out)), flush=True)
         if args.quick:
             return
         print("\n### Against thickness and substeps (2 threads; minimum distance on every %d-th "
