@@ -4,8 +4,12 @@
 # both measured in the same run: the ratio of wall times, run.json's per-stage seconds (broad,
 # proximity, ccd, fail-safe) and fail-safe runs, on 1 and 2 threads; then speed against
 # thickness (1, 3, 6 mm) and substeps (2, 4, 8): time ratio, minimum vertex-triangle distance
-# of the `on` run and intersecting pairs of both (tests/cli/count_intersections.py).
-#   bench/self_collision_bench.py [--build build] [--repeats 1] [--quick]
+# of the `on` run and intersecting pairs of both (tests/cli/count_intersections.py). The folding
+# sheet (bench/scenes/folding_sheet.toml, issue 27) the same way; --baseline BUILD runs another
+# build's gale alternately with this one (before/after of a change, in the same run). Times are
+# wall and user CPU seconds of the process (the machine is shared: CPU seconds scatter less).
+#   bench/self_collision_bench.py [--build build] [--repeats 1] [--quick] [--only cape|fold]
+#                                 [--baseline /work/main/build]
 import argparse
 import json
 import os
@@ -19,6 +23,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CAPE = os.path.join(ROOT, "examples", "03_cape", "scene.toml")
+FOLD = os.path.join(ROOT, "bench", "scenes", "folding_sheet.toml")
 sys.path.insert(0, os.path.join(ROOT, "tests", "cli"))
 import count_intersections  # noqa: E402  (the independent counter, beside the CLI tests)
 
@@ -36,24 +41,42 @@ def scene(on, thickness, substeps):
     return text
 
 
-def simulate(args, work, name, on, thickness=0.003, substeps=4, threads=2):
-    """Runs `gale sim` --repeats times; returns (median wall seconds, run.json, output folder)."""
+def foldScene(on):
+    """The folding sheet with self_collision set."""
+    return re.sub(r"(?m)^self_collision = .*$", "self_collision = %s" % ("true" if on else "false"),
+                  open(FOLD).read())
+
+
+def runGale(args, build, work, name, text, threads):
+    """Runs `gale sim` --repeats times; returns (median wall s, median user CPU s, run.json,
+    output folder)."""
     path = os.path.join(work, name + ".toml")
     with open(path, "w") as f:
-        f.write(scene(on, thickness, substeps))
-    walls = []
+        f.write(text)
+    walls, cpus = [], []
     for _ in range(args.repeats):
         out = os.path.join(work, name)
         shutil.rmtree(out, ignore_errors=True)
         start = time.perf_counter()
-        r = subprocess.run([os.path.join(args.build, "cli", "gale"), "sim", path, "-o", out,
-                            "--threads", str(threads)], stdout=subprocess.DEVNULL,
-                           stderr=subprocess.PIPE, text=True)
+        p = subprocess.Popen([os.path.join(build, "cli", "gale"), "sim", path, "-o", out,
+                              "--threads", str(threads)], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.PIPE, text=True)
+        err = p.stderr.read()
+        _, status, usage = os.wait4(p.pid, 0)
         walls.append(time.perf_counter() - start)
-        if r.returncode != 0:
-            sys.exit("gale sim %s: exit %d: %s" % (path, r.returncode, r.stderr[-400:]))
+        cpus.append(usage.ru_utime)
+        if os.waitstatus_to_exitcode(status) != 0:
+            sys.exit("gale sim %s: exit %d: %s" % (path, os.waitstatus_to_exitcode(status),
+                                                   err[-400:]))
     with open(os.path.join(out, "run.json")) as f:
-        return statistics.median(walls), json.load(f), out
+        return statistics.median(walls), statistics.median(cpus), json.load(f), out
+
+
+def simulate(args, work, name, on, thickness=0.003, substeps=4, threads=2):
+    """The cape: (median wall seconds, run.json, output folder)."""
+    wall, _, data, out = runGale(args, args.build, work, name, scene(on, thickness, substeps),
+                                 threads)
+    return wall, data, out
 
 
 def stages(run):
@@ -69,6 +92,46 @@ def stages(run):
             unresolved += sc["unresolved"]
         halved += sum(o["rejected_substeps"] for o in f["objects"])
     return s, runs, unresolved, halved
+
+
+def passes(run):
+    """Self-collision passes and candidate gatherings (full and incremental) of a run."""
+    n = g = 0
+    for f in run["frames"]:
+        sc = f.get("self_collision")
+        if sc:
+            n += sc["passes"]
+            g += sc["broad_phases"]
+    return n, g
+
+
+def folding(args, work):
+    """The folding sheet on and off, 2 and 1 threads; with --baseline, that build's gale and
+    this one alternately, each pair of runs (off, on) back to back."""
+    builds = [("this", args.build)]
+    if args.baseline:
+        builds.insert(0, ("baseline", args.baseline))
+    print("### Folding sheet (bench/scenes/folding_sheet.toml), 64x64, 3 mm, 4 substeps, "
+          "49 frames\n")
+    print("| build | threads | off s | on s | on / off | off CPU s | on CPU s | on / off CPU "
+          "| broad s | proximity s | ccd s | passes | gatherings | rejected substeps | "
+          "unresolved | on: pairs | on: min distance mm |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for threads in (2, 1):
+        for label, build in builds:
+            tag = "%s%d" % (label, threads)
+            off, offCpu, _, _ = runGale(args, build, work, "foldoff" + tag, foldScene(False),
+                                        threads)
+            on, onCpu, data, out = runGale(args, build, work, "foldon" + tag, foldScene(True),
+                                           threads)
+            s, _, unresolved, halved = stages(data)
+            n, g = passes(data)
+            print("| %s | %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %.2f | %.2f | "
+                  "%.2f | %d | %d | %d | %d | %d | %.2f |"
+                  % (label, threads, off, on, on / off, offCpu, onCpu, onCpu / offCpu,
+                     s["broad"], s["proximity"], s["ccd"], n, g, halved, unresolved, pairs(out),
+                     1000 * minDistance(out, 0.003, args.distance_step)), flush=True)
+    print()
 
 
 def frames(out, step):
@@ -93,23 +156,38 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--repeats", type=int, default=1)
-    ap.add_argument("--quick", action="store_true", help="threads table only")
+    ap.add_argument("--quick", action="store_true", help="threads tables only")
+    ap.add_argument("--only", choices=("cape", "fold"), help="one scene's tables")
+    ap.add_argument("--baseline", help="another build folder whose gale runs alternately")
     ap.add_argument("--distance-step", type=int, default=4,
                     help="minimum distance on every N-th frame (it costs ~1 s a frame)")
     args = ap.parse_args()
     work = tempfile.mkdtemp(prefix="gale_selfcoll_bench.")
     try:
+        if args.only != "cape":
+            folding(args, work)
+        if args.only == "fold":
+            return
         print("### 64x64 cape in gusts, thickness 3 mm, 4 substeps, 48 frames\n")
-        print("| threads | off s | on s | on / off | broad s | proximity s | ccd s | fail-safe s "
-              "| fail-safe runs | unresolved | rejected substeps |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        print("| build | threads | off s | on s | on / off | off CPU s | on CPU s | on / off CPU "
+              "| broad s | proximity s | ccd s | fail-safe s | fail-safe runs | unresolved "
+              "| rejected substeps | on: pairs |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        builds = [("this", args.build)]
+        if args.baseline:
+            builds.insert(0, ("baseline", args.baseline))
         for threads in (2, 1):
-            off, _, _ = simulate(args, work, "off%d" % threads, False, threads=threads)
-            on, run, _ = simulate(args, work, "on%d" % threads, True, threads=threads)
-            s, runs, unresolved, halved = stages(run)
-            print("| %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f | %.3f | %d | %d | %d |"
-                  % (threads, off, on, on / off, s["broad"], s["proximity"], s["ccd"],
-                     s["fail_safe"], runs, unresolved, halved), flush=True)
+            for label, build in builds:
+                tag = "%s%d" % (label, threads)
+                text = [scene(on, 0.003, 4) for on in (False, True)]
+                off, offCpu, _, _ = runGale(args, build, work, "off" + tag, text[0], threads)
+                on, onCpu, data, out = runGale(args, build, work, "on" + tag, text[1], threads)
+                s, runs, unresolved, halved = stages(data)
+                print("| %s | %d | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %.2f | %.2f "
+                      "| %.2f | %.3f | %d | %d | %d | %d |"
+                      % (label, threads, off, on, on / off, offCpu, onCpu, onCpu / offCpu,
+                         s["broad"], s["proximity"], s["ccd"], s["fail_safe"], runs, unresolved,
+                         halved, pairs(out)), flush=True)
         if args.quick:
             return
         print("\n### Against thickness and substeps (2 threads; minimum distance on every %d-th "

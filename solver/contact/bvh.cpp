@@ -12,7 +12,6 @@ constexpr int kLeafSize = 4;
 
 void Bvh::build(const std::vector<Box>& boxes) {
     mNodes.clear();
-    mBoxes = boxes;
     mOrder.resize(boxes.size());
     for (size_t i = 0; i < boxes.size(); ++i) mOrder[i] = static_cast<int>(i);
     std::vector<Eigen::Vector3d> centres(boxes.size());
@@ -20,9 +19,12 @@ void Bvh::build(const std::vector<Box>& boxes) {
     mNodes.reserve(2 * boxes.size() / kLeafSize + 2);
     if (boxes.empty()) {
         mNodes.emplace_back();
+        mLeafBoxes.clear();
         return;
     }
     buildRange(boxes, centres, 0, static_cast<int>(boxes.size()));
+    mLeafBoxes.resize(boxes.size());
+    for (size_t i = 0; i < boxes.size(); ++i) mLeafBoxes[i] = boxes[mOrder[i]];
 }
 
 int Bvh::buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>& centres, int begin,
@@ -58,18 +60,44 @@ int Bvh::buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>&
 }
 
 void Bvh::refit(const std::vector<Box>& boxes) {
-    mBoxes = boxes;
+    for (size_t i = 0; i < mOrder.size(); ++i) mLeafBoxes[i] = boxes[mOrder[i]];
     for (size_t k = mNodes.size(); k-- > 0;) {
         Node& n = mNodes[k];
         Box b;
         if (n.left < 0) {
-            for (int i = n.begin; i < n.end; ++i) b.add(boxes[mOrder[i]]);
+            for (int i = n.begin; i < n.end; ++i) b.add(mLeafBoxes[i]);
         } else {
             b.add(mNodes[n.left].box);
             b.add(mNodes[n.right].box);
         }
         n.box = b;
     }
+}
+
+std::vector<Bvh::PairTask> Bvh::pairTasks(const Bvh& other, std::size_t count) const {
+    std::vector<PairTask> tasks;
+    if (mOrder.empty() || other.mOrder.empty()) return tasks;
+    tasks.push_back({0, 0});
+    // Level by level, each task replaced by its children in the order the walk pops them (the
+    // reverse of their push order); pairs whose boxes do not overlap give nothing and are dropped.
+    while (tasks.size() < count) {
+        std::vector<PairTask> next;
+        bool split = false;
+        for (const PairTask& t : tasks) {
+            PairTask kids[3];
+            const int k = this->split(other, t, kids);
+            if (k < 0) continue;
+            if (k == 0) {
+                next.push_back(t);
+                continue;
+            }
+            split = true;
+            for (int i = k - 1; i >= 0; --i) next.push_back(kids[i]);
+        }
+        tasks.swap(next);
+        if (!split) break;
+    }
+    return tasks;
 }
 
 std::size_t Bvh::query(const Box& q, const std::function<void(int)>& fn) const {

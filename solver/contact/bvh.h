@@ -48,7 +48,23 @@ public:
     // one simultaneous descent of both trees (cheaper than a query per primitive when most of
     // them have neighbours). With other == *this, each unordered pair a ≠ b comes once.
     template <class Fn>
-    void overlappingPairs(const Bvh& other, Fn&& fn) const;
+    void overlappingPairs(const Bvh& other, Fn&& fn) const {
+        if (!mOrder.empty() && !other.mOrder.empty()) overlappingPairs(other, PairTask{0, 0}, fn);
+    }
+    // A node pair of that descent (this tree's node a, other's node b).
+    struct PairTask {
+        int a, b;
+    };
+    // The descent split into independent parts, at least `count` of them where the trees have
+    // that many overlapping node pairs: overlappingPairs(other, task, fn) over the tasks in order
+    // calls fn with exactly the pairs, in exactly the order, of overlappingPairs(other, fn) (a
+    // depth-first walk finishes each node pair before the one pushed below it). The parts can
+    // run in parallel and their outputs be concatenated: the result then does not depend on the
+    // threads.
+    std::vector<PairTask> pairTasks(const Bvh& other, std::size_t count) const;
+    // The descent from one node pair (a task of pairTasks).
+    template <class Fn>
+    void overlappingPairs(const Bvh& other, PairTask start, Fn&& fn) const;
     // The same walk without std::function (the visitor inlined): fn(primitive) in query()'s order.
     template <class Fn>
     std::size_t queryEach(const Box& q, Fn&& fn) const {
@@ -73,7 +89,7 @@ public:
             ++visited;
             if (!enter(n.box)) continue;
             if (n.left < 0) {
-                for (int i = n.begin; i < n.end; ++i) leaf(mOrder[i], mBoxes[mOrder[i]]);
+                for (int i = n.begin; i < n.end; ++i) leaf(mOrder[i], mLeafBoxes[i]);
             } else {
                 stack[top++] = n.left;
                 stack[top++] = n.right;
@@ -93,51 +109,69 @@ private:
     };
     int buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>& centres, int begin,
                    int end);
+    // One step of the descent from node pair t: −1 when the nodes' boxes do not overlap, 0 for a
+    // pair of leaves (or a leaf with itself), else the number of child pairs written to `kids`
+    // in the order they are pushed on the walk's stack (so popped in reverse).
+    int split(const Bvh& other, PairTask t, PairTask kids[3]) const;
     std::vector<Node> mNodes; // parents before children: a refit runs in reverse
     std::vector<int> mOrder;
-    std::vector<Box> mBoxes; // per primitive, as last built or refitted
+    // Per primitive as last built or refitted, in leaf order: mLeafBoxes[i] is primitive
+    // mOrder[i]'s (the pair tests of a leaf read them contiguously).
+    std::vector<Box> mLeafBoxes;
 };
 
+inline int Bvh::split(const Bvh& other, PairTask t, PairTask kids[3]) const {
+    const Node& na = mNodes[t.a];
+    const Node& nb = other.mNodes[t.b];
+    if (!na.box.overlaps(nb.box)) return -1;
+    const bool leafA = na.left < 0, leafB = nb.left < 0;
+    if (&other == this && t.a == t.b) {
+        if (leafA) return 0;
+        kids[0] = {na.left, na.left};
+        kids[1] = {na.right, na.right};
+        kids[2] = {na.left, na.right};
+        return 3;
+    }
+    if (leafA && leafB) return 0;
+    if (leafB || (!leafA && (na.box.hi - na.box.lo).sum() >= (nb.box.hi - nb.box.lo).sum())) {
+        kids[0] = {na.left, t.b};
+        kids[1] = {na.right, t.b};
+    } else {
+        kids[0] = {t.a, nb.left};
+        kids[1] = {t.a, nb.right};
+    }
+    return 2;
+}
+
 template <class Fn>
-void Bvh::overlappingPairs(const Bvh& other, Fn&& fn) const {
-    if (mOrder.empty() || other.mOrder.empty()) return;
+void Bvh::overlappingPairs(const Bvh& other, PairTask start, Fn&& fn) const {
     const bool self = &other == this;
-    struct Task {
-        int a, b;
-    };
-    std::vector<Task> stack;
-    stack.push_back({0, 0});
-    while (!stack.empty()) {
-        const Task t = stack.back();
-        stack.pop_back();
-        const Node& na = mNodes[t.a];
-        const Node& nb = other.mNodes[t.b];
-        if (!na.box.overlaps(nb.box)) continue;
-        const bool leafA = na.left < 0, leafB = nb.left < 0;
-        if (self && t.a == t.b) {
-            if (leafA) {
-                for (int i = na.begin; i < na.end; ++i)
-                    for (int j = i + 1; j < na.end; ++j)
-                        if (mBoxes[mOrder[i]].overlaps(mBoxes[mOrder[j]])) fn(mOrder[i], mOrder[j]);
-            } else {
-                stack.push_back({na.left, na.left});
-                stack.push_back({na.right, na.right});
-                stack.push_back({na.left, na.right});
-            }
+    // Each step pops one pair and pushes ≤ 3, one level deeper in either tree: ≤ 2 per level of
+    // the ≤ 60 levels of two median-split trees over < 2³¹ primitives.
+    PairTask stack[256];
+    int top = 0;
+    stack[top++] = start;
+    while (top > 0) {
+        const PairTask t = stack[--top];
+        PairTask kids[3];
+        const int k = split(other, t, kids);
+        if (k > 0) {
+            for (int i = 0; i < k; ++i) stack[top++] = kids[i];
             continue;
         }
-        if (leafA && leafB) {
+        if (k < 0) continue;
+        const Node& na = mNodes[t.a];
+        const Node& nb = other.mNodes[t.b];
+        if (self && t.a == t.b) {
             for (int i = na.begin; i < na.end; ++i)
-                for (int j = nb.begin; j < nb.end; ++j)
-                    if (mBoxes[mOrder[i]].overlaps(other.mBoxes[other.mOrder[j]]))
-                        fn(mOrder[i], other.mOrder[j]);
-        } else if (leafB ||
-                   (!leafA && (na.box.hi - na.box.lo).sum() >= (nb.box.hi - nb.box.lo).sum())) {
-            stack.push_back({na.left, t.b});
-            stack.push_back({na.right, t.b});
-        } else {
-            stack.push_back({t.a, nb.left});
-            stack.push_back({t.a, nb.right});
+                for (int j = i + 1; j < na.end; ++j)
+                    if (mLeafBoxes[i].overlaps(mLeafBoxes[j])) fn(mOrder[i], mOrder[j]);
+            continue;
+        }
+        for (int i = na.begin; i < na.end; ++i) {
+            const Box& bi = mLeafBoxes[i];
+            for (int j = nb.begin; j < nb.end; ++j)
+                if (bi.overlaps(other.mLeafBoxes[j])) fn(mOrder[i], other.mOrder[j]);
         }
     }
 }

@@ -134,3 +134,46 @@ TEST_CASE("bvh: queryEach visits query's primitives in its order; a pruned walk 
     CHECK(unit.distance2(Eigen::Vector3d(0.5, 0.5, 0.5)) == 0.0);
     CHECK(unit.distance2(Eigen::Vector3d(2, 0.5, -1)) == Approx(2.0)); // 1² + 1²
 }
+
+TEST_CASE("bvh: the pair walk split into tasks gives the whole walk's pairs in its order",
+          "[contact][bvh]") {
+    // Concatenating the tasks' pairs must reproduce overlappingPairs exactly (the self-collision
+    // broad phase runs the tasks in parallel and relies on the order), for two trees and for one
+    // tree against itself, at several split counts, also after a refit.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    auto boxes = [&](int n, double size) {
+        std::vector<Box> out(n);
+        for (int i = 0; i < n; ++i) {
+            const Eigen::Vector3d c(U(rng), U(rng), U(rng));
+            out[i].add(c);
+            out[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+        }
+        return out;
+    };
+    std::vector<Box> a = boxes(1200, 0.05), b = boxes(500, 0.08);
+    Bvh ta, tb;
+    ta.build(a);
+    tb.build(b);
+    for (int round = 0; round < 2; ++round) {
+        for (const Bvh* other : {&tb, &ta}) {
+            std::vector<std::pair<int, int>> whole;
+            ta.overlappingPairs(*other, [&](int i, int j) { whole.emplace_back(i, j); });
+            REQUIRE(whole.size() > 20);
+            for (size_t count : {1, 2, 7, 64, 1000}) {
+                const auto tasks = ta.pairTasks(*other, count);
+                CHECK(tasks.size() >= std::min<size_t>(count, 8)); // these trees split that far
+                std::vector<std::pair<int, int>> split;
+                for (const auto& t : tasks)
+                    ta.overlappingPairs(*other, t, [&](int i, int j) { split.emplace_back(i, j); });
+                CHECK(split == whole);
+            }
+        }
+        // Moved boxes, the same topology.
+        a = boxes(1200, 0.06);
+        ta.refit(a);
+    }
+    Bvh empty;
+    empty.build({});
+    CHECK(empty.pairTasks(ta, 8).empty());
+}

@@ -41,6 +41,11 @@ constexpr int kChunk = 64;         // primitives per parallel chunk (results ord
 constexpr int kRebuildEvery = 8;   // passes between tree rebuilds (refits in between)
 // Candidates stay valid while no vertex moves more than this × ξ from where they were gathered.
 constexpr double kMoveAllowance = 0.5;
+// A re-gather queries only the moved vertices' primitives while at most 1/kRegatherShare of the
+// vertices moved beyond the allowance (ensureCandidates).
+constexpr size_t kRegatherShare = 8;
+// Relative margin of the early outs on box distances (far above the 1e-15 rounding of distances).
+constexpr double kBoundMargin = 1e-6;
 // Proximity: the fraction of the way back to ξ a pair already closer at the start is eased per
 // substep.
 constexpr double kEase = 0.25;
@@ -125,6 +130,7 @@ void SelfCollision::addBody(Body& body, const std::vector<std::array<int, 3>>& t
         mAdjacencyStart.push_back(static_cast<int>(mAdjacency.size()));
     }
     mBuilt = false;
+    mCandidatesValid = false;
 }
 
 void SelfCollision::gather() {
@@ -165,14 +171,15 @@ void SelfCollision::scatter() {
     }
 }
 
-void SelfCollision::refitBoxes(bool swept, double inflate) {
-    // Boxes of vertices, triangles and edges over the step (or at x₁), each inflated by
-    // `inflate`: overlapping boxes cover every pair within 2·inflate.
+void SelfCollision::refitBoxes(const std::vector<double>& lo, const std::vector<double>& hi,
+                               double inflate) {
+    // Boxes of vertices, triangles and edges: the union of their vertices' boxes [lo, hi],
+    // inflated by `inflate` (overlapping boxes cover every pair within 2·inflate of them).
     const auto boxOf = [&](const int* v, int count) {
         Box b;
         for (int k = 0; k < count; ++k) {
-            b.add(Vec3(vec3At(mX1.data(), v[k])));
-            if (swept) b.add(Vec3(vec3At(mX0.data(), v[k])));
+            b.add(Vec3(vec3At(lo.data(), v[k])));
+            b.add(Vec3(vec3At(hi.data(), v[k])));
         }
         b.inflate(inflate);
         return b;
@@ -207,36 +214,50 @@ double SelfCollision::pairThickness(const Pair& p) const {
 
 // Vertex–triangle pairs (v, a, b, c) and edge–edge pairs (p, q, r, s) whose boxes (refitBoxes)
 // overlap, the primitives sharing no vertex and not all held; α left to the narrow phase. One
-// simultaneous descent of two trees each (bvh.h), the two kinds side by side; the order of the
-// pairs depends only on the trees.
-void SelfCollision::gatherCandidates(std::vector<Pair>& vtOut, std::vector<Pair>& eeOut) const {
+// simultaneous descent of two trees each (bvh.h), split into parts that run in parallel, each
+// into its own list, concatenated in the walk's order: the pairs and their order depend only on
+// the trees, not on the threads.
+void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
+                                     std::vector<Candidate>& eeOut) const {
     const auto held = [&](int a, int b, int c, int d) {
         return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
     };
-    tbb::parallel_invoke(
-        [&] {
-            vtOut.clear();
-            mVertTree.overlappingPairs(mTriTree, [&](int vi, int t) {
+    constexpr size_t kTasks = 64; // parts per kind (a few per thread, for balance)
+    const std::vector<contact::Bvh::PairTask> vtTasks = mVertTree.pairTasks(mTriTree, kTasks);
+    const std::vector<contact::Bvh::PairTask> eeTasks = mEdgeTree.pairTasks(mEdgeTree, kTasks);
+    std::vector<std::vector<Candidate>> parts(vtTasks.size() + eeTasks.size());
+    tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
+        std::vector<Candidate>& out = parts[k];
+        if (k < vtTasks.size()) {
+            mVertTree.overlappingPairs(mTriTree, vtTasks[k], [&](int vi, int t) {
                 const auto& tri = mTris[t];
                 if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
                 if (held(vi, tri[0], tri[1], tri[2])) return; // nothing can move
-                vtOut.push_back({{vi, tri[0], tri[1], tri[2]}, {1.0, 0.0, 0.0, 0.0}});
+                out.push_back({vi, tri[0], tri[1], tri[2]});
             });
-        },
-        [&] {
-            eeOut.clear();
-            mEdgeTree.overlappingPairs(mEdgeTree, [&](int e, int f) {
-                const auto& ea = mEdges[e];
-                const auto& eb = mEdges[f];
-                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
-                if (held(ea[0], ea[1], eb[0], eb[1])) return;
-                // Strand against strand (hair has no triangles): not modelled.
-                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
-                    !mBodyHasTriangles[mVertexBody[eb[0]]])
-                    return;
-                eeOut.push_back({{ea[0], ea[1], eb[0], eb[1]}, {0.0, 0.0, 0.0, 0.0}});
-            });
+            return;
+        }
+        mEdgeTree.overlappingPairs(mEdgeTree, eeTasks[k - vtTasks.size()], [&](int e, int f) {
+            const auto& ea = mEdges[e];
+            const auto& eb = mEdges[f];
+            if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
+            if (held(ea[0], ea[1], eb[0], eb[1])) return;
+            // Strand against strand (hair has no triangles): not modelled.
+            if (!mBodyHasTriangles[mVertexBody[ea[0]]] && !mBodyHasTriangles[mVertexBody[eb[0]]])
+                return;
+            out.push_back({ea[0], ea[1], eb[0], eb[1]});
         });
+    });
+    const auto concatenate = [&](size_t begin, size_t end, std::vector<Candidate>& all) {
+        size_t total = 0;
+        for (size_t k = begin; k < end; ++k) total += parts[k].size();
+        all.clear();
+        all.reserve(total);
+        for (size_t k = begin; k < end; ++k)
+            all.insert(all.end(), parts[k].begin(), parts[k].end());
+    };
+    concatenate(0, vtTasks.size(), vtOut);
+    concatenate(vtTasks.size(), parts.size(), eeOut);
 }
 
 double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) const {
@@ -248,12 +269,34 @@ double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) co
         mean += d[k];
     }
     mean /= 4.0;
+    // The largest squared norm per side, then one square root each (√ is monotonic and
+    // correctly rounded: the same value as the largest of the norms).
     double la = 0.0, lb = 0.0;
     for (int k = 0; k < 4; ++k) {
         double& side = (vertexTriangle ? k < 1 : k < 2) ? la : lb;
-        side = std::max(side, (d[k] - mean).norm());
+        side = std::max(side, (d[k] - mean).squaredNorm());
     }
-    return (la + lb) * (1.0 + 1e-12);
+    return (std::sqrt(la) + std::sqrt(lb)) * (1.0 + 1e-12);
+}
+
+double SelfCollision::boxGap(const std::vector<double>& x, const Pair& p,
+                             bool vertexTriangle) const {
+    // The two primitives' boxes at x and the distance between them: the closest points lie in
+    // the boxes, so no pair of points is closer.
+    const int first = vertexTriangle ? 1 : 2;
+    Vec3 loA = vec3At(x.data(), p.v[0]), hiA = loA;
+    Vec3 loB = vec3At(x.data(), p.v[first]), hiB = loB;
+    for (int k = 1; k < first; ++k) {
+        const Vec3 y = vec3At(x.data(), p.v[k]);
+        loA = loA.cwiseMin(y);
+        hiA = hiA.cwiseMax(y);
+    }
+    for (int k = first + 1; k < 4; ++k) {
+        const Vec3 y = vec3At(x.data(), p.v[k]);
+        loB = loB.cwiseMin(y);
+        hiB = hiB.cwiseMax(y);
+    }
+    return (loA - hiB).cwiseMax(loB - hiA).cwiseMax(0.0).norm();
 }
 
 bool SelfCollision::adjacent(int a, int b) const {
@@ -347,22 +390,57 @@ void stopApproach(std::vector<double>& v, const std::vector<double>& invMass,
 }
 } // namespace
 
+void SelfCollision::setRegion(size_t i, double delta) {
+    for (int j = 0; j < 3; ++j) {
+        const double a = mX0[3 * i + j], b = mX1[3 * i + j];
+        mRegionLo[3 * i + j] = std::min(a, b) - delta;
+        mRegionHi[3 * i + j] = std::max(a, b) + delta;
+    }
+}
+
 bool SelfCollision::ensureCandidates() {
-    // Valid while no vertex has moved more than δ = ξ/2 from where they were gathered: boxes
-    // inflated by ξ on each side then still cover every pair within ξ (proximity) or whose path
-    // comes within ξ_c ≤ ξ (CCD), since each box has grown by at most δ per side.
+    // The candidates were gathered over per-vertex regions: the box of the vertex's path
+    // x₀ → x₁ then, grown by δ = ξ/2 (setRegion), each primitive's box the union of its
+    // vertices' regions inflated by ξ/2. While every vertex's path x₀ → x₁ (the straight line
+    // of the step) stays inside its region, so does every primitive's swept box inside its
+    // gathered box, and the candidates still hold every pair within ξ at x₁ (proximity) or
+    // whose path comes within ξ_c ≤ ξ (CCD): after the pass's corrections and in later passes
+    // (a pile at rest keeps its candidates from substep to substep).
     const double delta = kMoveAllowance * mMaxThickness;
+    const size_t n = mX1.size() / 3;
     if (mCandidatesValid) {
-        double moved2 = 0.0;
-        for (size_t i = 0; i < mX1.size() / 3; ++i)
-            moved2 = std::max(
-                moved2, (Vec3(vec3At(mX1.data(), i)) - Vec3(vec3At(mXc.data(), i))).squaredNorm());
-        if (moved2 <= delta * delta) return false;
+        std::vector<uint8_t> moved(n, 0);
+        size_t count = 0;
+        for (size_t i = 0; i < n; ++i)
+            for (int j = 0; j < 3; ++j) {
+                const double lo = mRegionLo[3 * i + j], hi = mRegionHi[3 * i + j];
+                const double a = mX0[3 * i + j], b = mX1[3 * i + j];
+                if (!(a >= lo && a <= hi && b >= lo && b <= hi)) {
+                    moved[i] = 1;
+                    ++count;
+                    break;
+                }
+            }
+        if (count == 0) return false;
+        // A CCD correction moves the few vertices of the pairs it hit, a resting pile only its
+        // few sliding vertices: re-query only those (the pairs of the others are still
+        // covered). When many left their regions, gather afresh.
+        if (count * kRegatherShare <= n) {
+            const auto t0 = std::chrono::steady_clock::now();
+            regatherMoved(moved);
+            mMaybeValid = false;
+            ++mStats.broadPhases;
+            mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
+            mStats.broadSeconds += seconds(t0);
+            return true;
+        }
     }
     const auto t0 = std::chrono::steady_clock::now();
-    refitBoxes(true, (0.5 + kMoveAllowance) * mMaxThickness);
+    mRegionLo.resize(3 * n);
+    mRegionHi.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) setRegion(i, delta);
+    refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
     gatherCandidates(mCandVt, mCandEe);
-    mXc = mX1;
     mCandidatesValid = true;
     mMaybeValid = false;
     ++mStats.broadPhases;
@@ -371,12 +449,83 @@ bool SelfCollision::ensureCandidates() {
     return true;
 }
 
+void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
+    // The moved vertices get new regions (the others keep theirs) and every primitive's box is
+    // recomputed from them, exactly as at a full gathering (ensureCandidates). A pair of
+    // unmoved vertices has the same boxes as when it was gathered, so it is in the old list
+    // exactly when they overlap; a pair with a moved vertex is found by a query of the moved
+    // primitive's new box.
+    const size_t n = moved.size();
+    for (size_t i = 0; i < n; ++i)
+        if (moved[i]) setRegion(i, kMoveAllowance * mMaxThickness);
+    refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
+    const auto touches = [&](const Candidate& c) {
+        return moved[c[0]] || moved[c[1]] || moved[c[2]] || moved[c[3]];
+    };
+    mCandVt.erase(std::remove_if(mCandVt.begin(), mCandVt.end(), touches), mCandVt.end());
+    mCandEe.erase(std::remove_if(mCandEe.begin(), mCandEe.end(), touches), mCandEe.end());
+    const auto held = [&](int a, int b, int c, int d) {
+        return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
+    };
+    // Vertex–triangle: the moved vertices against every triangle, then the triangles with a
+    // moved corner against the unmoved vertices (each new pair once).
+    std::vector<int> movedVerts, movedTris, movedEdges;
+    for (size_t i = 0; i < n; ++i)
+        if (moved[i]) movedVerts.push_back(static_cast<int>(i));
+    for (size_t t = 0; t < mTris.size(); ++t)
+        if (moved[mTris[t][0]] || moved[mTris[t][1]] || moved[mTris[t][2]])
+            movedTris.push_back(static_cast<int>(t));
+    std::vector<uint8_t> edgeMoved(mEdges.size(), 0);
+    for (size_t e = 0; e < mEdges.size(); ++e)
+        if (moved[mEdges[e][0]] || moved[mEdges[e][1]]) {
+            edgeMoved[e] = 1;
+            movedEdges.push_back(static_cast<int>(e));
+        }
+    const auto vertexTriangle = [&](int vi, int t, std::vector<Candidate>& out) {
+        const auto& tri = mTris[t];
+        if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
+        if (held(vi, tri[0], tri[1], tri[2])) return;
+        out.push_back({vi, tri[0], tri[1], tri[2]});
+    };
+    const size_t nv = movedVerts.size(), nt = movedTris.size();
+    const std::vector<Candidate> vt =
+        parallelCollect<Candidate>(nv + nt, [&](size_t k, std::vector<Candidate>& out) {
+            if (k < nv) {
+                const int vi = movedVerts[k];
+                mTriTree.queryEach(mVertBoxes[vi], [&](int t) { vertexTriangle(vi, t, out); });
+                return;
+            }
+            const int t = movedTris[k - nv];
+            mVertTree.queryEach(mTriBoxes[t], [&](int vi) {
+                if (!moved[vi]) vertexTriangle(vi, t, out);
+            });
+        });
+    mCandVt.insert(mCandVt.end(), vt.begin(), vt.end());
+    // Edge–edge: each moved edge against every edge; a pair of two moved edges from the lower.
+    const std::vector<Candidate> ee =
+        parallelCollect<Candidate>(movedEdges.size(), [&](size_t k, std::vector<Candidate>& out) {
+            const int e = movedEdges[k];
+            const auto& ea = mEdges[e];
+            mEdgeTree.queryEach(mEdgeBoxes[e], [&](int f) {
+                if (edgeMoved[f] && f <= e) return;
+                const auto& eb = mEdges[f];
+                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
+                if (held(ea[0], ea[1], eb[0], eb[1])) return;
+                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
+                    !mBodyHasTriangles[mVertexBody[eb[0]]])
+                    return;
+                out.push_back({ea[0], ea[1], eb[0], eb[1]});
+            });
+        });
+    mCandEe.insert(mCandEe.end(), ee.begin(), ee.end());
+}
+
 int SelfCollision::proximity() {
     ensureCandidates();
     std::vector<Contact> contacts;
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
-        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        const std::vector<Candidate>& cands = vt ? mCandVt : mCandEe;
         // Also which pairs CCD must test (the first round adds those proximity moves): the
         // distance is Lipschitz in t with the relative displacement bound l, so d(t) ≥ d₁ − l
         // and a pair with d₁ − l > ξ_c cannot come within ξ_c during the step.
@@ -384,11 +533,15 @@ int SelfCollision::proximity() {
         maybe.assign(cands.size(), 0);
         std::vector<Contact> found =
             parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& out) {
-                Pair p = cands[c];
-                double d1 = 0.0, d0 = 0.0;
-                const Vec3 r1 = closestPair(mX1, p, vt, d1);
+                Pair p{cands[c], {}};
                 const double xi = pairThickness(p);
                 const double l = relativeMotionBound(p, vt);
+                // Early out: the boxes' distance g ≤ d₁, so g − l > ξ (with a margin far above
+                // the rounding of either distance) means d₁ − l > ξ > ξ_c: no contact and
+                // nothing for CCD — what the exact distance below would decide.
+                if (boxGap(mX1, p, vt) - l > xi * (1.0 + kBoundMargin)) return;
+                double d1 = 0.0, d0 = 0.0;
+                const Vec3 r1 = closestPair(mX1, p, vt, d1);
                 if (!(d1 - l > mSettings.ccdFraction * xi)) maybe[c] = 1;
                 // Within ξ at the end, or at the start (d₀ ≥ d₁ − l): a pair in resting contact
                 // keeps its side and normal from x₀ even when the step would take it through.
@@ -436,11 +589,11 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
     std::atomic<long long> touching{0};
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
-        const std::vector<Pair>& cands = vt ? mCandVt : mCandEe;
+        const std::vector<Candidate>& cands = vt ? mCandVt : mCandEe;
         const std::vector<uint8_t>* maybe = dirty && mMaybeValid ? &mMaybe[vt ? 0 : 1] : nullptr;
         std::vector<Contact> out =
             parallelCollect<Contact>(cands.size(), [&](size_t c, std::vector<Contact>& hitsOut) {
-                Pair p = cands[c];
+                Pair p{cands[c], {}};
                 // A pair none of whose vertices moved since a round that found it clear, and that
                 // was not hit then, has the same path: still clear.
                 if (dirty && !(maybe && (*maybe)[c]) && !(*dirty)[p.v[0]] && !(*dirty)[p.v[1]] &&
@@ -454,6 +607,10 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 const auto x0 = [&](int k) { return Vec3(vec3At(mX0.data(), p.v[k])); };
                 const auto x1 = [&](int k) { return Vec3(vec3At(mX1.data(), p.v[k])); };
                 const double xiC = mSettings.ccdFraction * pairThickness(p);
+                // Early out as in proximity: the boxes' distance at x₀ bounds d₀ from below, so
+                // this is the cheap rejection below (not touching, d₀ − l > ξ_c) decided sooner.
+                const double l = relativeMotionBound(p, vt);
+                if (boxGap(mX0, p, vt) - l > xiC * (1.0 + kBoundMargin)) return;
                 double d0 = 0.0;
                 closestPair(mX0, p, vt, d0);
                 if (!(d0 > kTouching)) {
@@ -462,7 +619,7 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 }
                 // Cheap rejection: the distance at x₀ less the largest relative displacement stays
                 // above the CCD thickness (the bound conservative advancement starts from).
-                if (d0 - relativeMotionBound(p, vt) > xiC) return;
+                if (d0 - l > xiC) return;
                 contact::CcdOptions opt;
                 opt.thickness = xiC;
                 opt.shrinkWithinThickness = true;
@@ -658,7 +815,6 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
         std::copy(start[b].data(), start[b].data() + start[b].size(),
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
-    mCandidatesValid = false;
     mLastHits.clear();
     auto t0 = std::chrono::steady_clock::now();
     std::vector<double> before = mX1;
@@ -716,13 +872,14 @@ double SelfCollision::minimumSeparation(double radius) const {
     probe.mX0 = probe.mX1;
     probe.mBuilt = false;
     probe.mStats = SelfCollisionStats();
-    probe.refitBoxes(false, 0.5 * radius);
+    probe.refitBoxes(probe.mX1, probe.mX1, 0.5 * radius);
     probe.mCandidatesValid = false;
     double best = INFINITY;
-    std::vector<Pair> cands[2];
+    std::vector<Candidate> cands[2];
     probe.gatherCandidates(cands[0], cands[1]);
     for (int kind = 0; kind < 2; ++kind)
-        for (Pair p : cands[kind]) {
+        for (const Candidate& c : cands[kind]) {
+            Pair p{c, {}};
             double d = 0.0;
             closestPair(probe.mX1, p, kind == 0, d);
             if (d < best && !probe.restClose(p, kind == 0)) best = d;
