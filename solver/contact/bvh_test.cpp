@@ -10,6 +10,20 @@
 
 using namespace gale::solver::contact;
 
+namespace {
+// n boxes with corners at uniform points of the unit cube and edges up to `size`.
+std::vector<Box> randomBoxes(std::mt19937& rng, int n, double size) {
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    std::vector<Box> out(n);
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d c(U(rng), U(rng), U(rng));
+        out[i].add(c);
+        out[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+    }
+    return out;
+}
+} // namespace
+
 TEST_CASE("bvh: queries match brute force, also after a refit", "[contact][bvh]") {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> U(0.0, 1.0);
@@ -58,16 +72,7 @@ TEST_CASE("bvh: queries match brute force, also after a refit", "[contact][bvh]"
 
 TEST_CASE("bvh: overlapping pairs of two trees and of one tree match brute force", "[contact][bvh]") {
     std::mt19937 rng(11);
-    std::uniform_real_distribution<double> U(0.0, 1.0);
-    auto boxes = [&](int n, double size) {
-        std::vector<Box> out(n);
-        for (int i = 0; i < n; ++i) {
-            const Eigen::Vector3d c(U(rng), U(rng), U(rng));
-            out[i].add(c);
-            out[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
-        }
-        return out;
-    };
+    auto boxes = [&](int n, double size) { return randomBoxes(rng, n, size); };
     const std::vector<Box> a = boxes(700, 0.05), b = boxes(900, 0.08);
     Bvh ta, tb;
     ta.build(a);
@@ -141,16 +146,7 @@ TEST_CASE("bvh: the pair walk split into tasks gives the whole walk's pairs in i
     // broad phase runs the tasks in parallel and relies on the order), for two trees and for one
     // tree against itself, at several split counts, also after a refit.
     std::mt19937 rng(5);
-    std::uniform_real_distribution<double> U(0.0, 1.0);
-    auto boxes = [&](int n, double size) {
-        std::vector<Box> out(n);
-        for (int i = 0; i < n; ++i) {
-            const Eigen::Vector3d c(U(rng), U(rng), U(rng));
-            out[i].add(c);
-            out[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
-        }
-        return out;
-    };
+    auto boxes = [&](int n, double size) { return randomBoxes(rng, n, size); };
     std::vector<Box> a = boxes(1200, 0.05), b = boxes(500, 0.08);
     Bvh ta, tb;
     ta.build(a);
