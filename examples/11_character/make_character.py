@@ -524,7 +524,10 @@ def main(argv):
         k = argv.index("--root-offset")
         if k + 1 >= len(argv):
             sys.exit("make_character.py: --root-offset needs a distance in metres")
-        root_offset = float(argv[k + 1])
+        try:
+            root_offset = float(argv[k + 1])
+        except ValueError:
+            sys.exit("make_character.py: --root-offset needs a distance in metres, not %r" % argv[k + 1])
         argv = argv[:k] + argv[k + 2:]
     folder = argv[0] if argv else "body"
     V, W, T = build_skin()
