@@ -556,7 +556,6 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
     for (size_t k = 0; k < mKin.colliders.size(); ++k) {
         const Collider& c = (*env.colliders)[k];
         const double thick = mKin.colliders[k].thickness;
-        const ColliderPose& pose = mKin.colliders[k].end;
         const int ci = static_cast<int>(k);
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
@@ -615,7 +614,6 @@ int Body::resolveContacts(const Environment& env, double h, SubstepStatus& st) {
     for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
         const Collider& c = (*env.colliders)[ci];
         const double thick = mKin.colliders[ci].thickness;
-        const ColliderPose& pose = mKin.colliders[ci].end;
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] == 1 && mContactCollider[i] < 0) continue; // pin or held
             Eigen::Map<Vec3> x(mX.data() + 3 * i);
