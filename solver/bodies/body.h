@@ -383,7 +383,7 @@ private:
     std::vector<uint8_t> mFoundInside;    // per vertex: its contact came from ending inside
     // Per collider and vertex, within a substep: a lower bound (m) on the distance to the
     // collider's end pose, known at position mEndAt (the distance is 1-Lipschitz in x, so a
-    // vertex that moved less than bound − ξ since cannot be within ξ: endPoseFar()); −1 unknown.
+    // vertex that moved less than bound − ξ since cannot be within ξ: endPoseQuery()); −1 unknown.
     std::vector<double> mEndBound;
     VecX mEndAt;
     std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)

@@ -236,9 +236,16 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // after it (Body::resolveContacts) restores the full thickness everywhere else.
     // Already within the thickness at the start (resting contact): only crossing is caught
     // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
-    contact::CcdOptions opt;
-    opt.thickness = 0.5 * thickness;
-    opt.shrinkWithinThickness = true;
+    // For a primitive held off the body by ξ: the CCD's options, and the distance a hit is
+    // placed at (ξ and ξ/2 as above; ξ_e below for pinned vertices within the thickness).
+    const auto optionsFor = [](double xi) {
+        contact::CcdOptions o;
+        o.thickness = 0.5 * xi;
+        o.shrinkWithinThickness = true;
+        return o;
+    };
+    const auto placedAt = [](double xi) { return xi * (1.0 + 1e-6) + 1e-9; };
+    const contact::CcdOptions opt = optionsFor(thickness);
     std::vector<int> cand;
     std::vector<uint8_t> moved(n, 0);
     // Cloth triangles hit by a body vertex that no movable corner can carry (all pinned, or the
@@ -262,7 +269,6 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             ++movedCount;
         }
     };
-    const double want = thickness * (1.0 + 1e-6) + 1e-9; // the distance a hit is placed at
     auto surfaceVelocity = [&](int tri, const double w[3]) {
         Vec3 vs = Vec3::Zero();
         if (h > 0.0)
@@ -286,12 +292,6 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             c = std::max(c, 1e-3 * thickness); // on the surface: only crossing is caught
         }
         return c;
-    };
-    // The CCD options and the distance a hit is placed at, for a primitive held off by xi.
-    auto optionsFor = [&](double xi) {
-        contact::CcdOptions o = opt;
-        o.thickness = 0.5 * xi;
-        return o;
     };
     for (int pass = 0; pass < passes; ++pass) {
         int hits = 0;
@@ -350,7 +350,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                 if (!interior) n1 = nt.normalized();
                 Vec3 q1 = Vec3::Zero();
                 for (int k = 0; k < 3; ++k) q1 += w[k] * corner(true, t[k]);
-                vec3At(x1.data(), i) = q1 + (thickness * (1.0 + 1e-6) + 1e-9) * n1;
+                vec3At(x1.data(), i) = q1 + placedAt(thickness) * n1;
                 respond(static_cast<int>(i), surfaceVelocity(hitTri, w), n1);
                 ++hits;
                 ++mStats.vertexHits;
@@ -362,8 +362,8 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const int i = e[0], j = e[1];
             if (!movable[i] && !movable[j]) continue;
             const double xiE = std::min(clearanceOf(i), clearanceOf(j));
-            const contact::CcdOptions optE = xiE < thickness ? optionsFor(xiE) : opt;
-            const double wantE = xiE < thickness ? xiE * (1.0 + 1e-6) + 1e-9 : want;
+            const contact::CcdOptions optE = optionsFor(xiE);
+            const double wantE = placedAt(xiE);
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
             if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
@@ -426,7 +426,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                     (movable[i] ? 0.0 : (1.0 - sa) * std::max(0.0, wantE - (xa - body1).dot(nn))) -
                     (movable[j] ? 0.0 : sa * std::max(0.0, wantE - (xb - body1).dot(nn)));
                 if (gap < wantHere) {
-                    // Move the cloth point by (want − gap) n: the edge's vertices by their
+                    // Move the cloth point by (ξ' − gap) n: the edge's vertices by their
                     // weights, scaled so the interpolated point moves exactly that far.
                     const double wa = movable[i] ? 1.0 - sa : 0.0, wb = movable[j] ? sa : 0.0;
                     const double norm = wa * (1.0 - sa) + wb * sa;
@@ -462,8 +462,8 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!finite) continue; // left to the trouble detector
             const double xiT =
                 std::min({clearanceOf(tv[0]), clearanceOf(tv[1]), clearanceOf(tv[2])});
-            const contact::CcdOptions optT = xiT < thickness ? optionsFor(xiT) : opt;
-            const double wantT = xiT < thickness ? xiT * (1.0 + 1e-6) + 1e-9 : want;
+            const contact::CcdOptions optT = optionsFor(xiT);
+            const double wantT = placedAt(xiT);
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
             for (int k = 0; k < 3; ++k) {

@@ -454,17 +454,13 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
             mLdlt->analyzePattern(mFilteredA);
         }
     }
-    bool ok;
-    if (mLdltBanded) {
-        mLdltBanded->factorize(mFilteredA);
-        ok = mLdltBanded->info() == Eigen::Success;
-        if (ok) y = mLdltBanded->solve(rhs);
-    } else {
-        mLdlt->factorize(mFilteredA);
-        ok = mLdlt->info() == Eigen::Success;
-        if (ok) y = mLdlt->solve(rhs);
-    }
-    if (!ok) {
+    const auto factorSolve = [&](auto& ldlt) {
+        ldlt.factorize(mFilteredA);
+        if (ldlt.info() != Eigen::Success) return false;
+        y = ldlt.solve(rhs);
+        return true;
+    };
+    if (!(mLdltBanded ? factorSolve(*mLdltBanded) : factorSolve(*mLdlt))) {
         st.failed = true;
         return st;
     }

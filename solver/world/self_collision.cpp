@@ -219,9 +219,6 @@ double SelfCollision::pairThickness(const Pair& p) const {
 // the trees, not on the threads.
 void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
                                      std::vector<Candidate>& eeOut) const {
-    const auto held = [&](int a, int b, int c, int d) {
-        return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
-    };
     constexpr size_t kTasks = 64; // parts per kind (a few per thread, for balance)
     const std::vector<contact::Bvh::PairTask> vtTasks = mVertTree.pairTasks(mTriTree, kTasks);
     const std::vector<contact::Bvh::PairTask> eeTasks = mEdgeTree.pairTasks(mEdgeTree, kTasks);
@@ -230,22 +227,14 @@ void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
         std::vector<Candidate>& out = parts[k];
         if (k < vtTasks.size()) {
             mVertTree.overlappingPairs(mTriTree, vtTasks[k], [&](int vi, int t) {
-                const auto& tri = mTris[t];
-                if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
-                if (held(vi, tri[0], tri[1], tri[2])) return; // nothing can move
-                out.push_back({vi, tri[0], tri[1], tri[2]});
+                if (candidateVertexTriangle(vi, t))
+                    out.push_back({vi, mTris[t][0], mTris[t][1], mTris[t][2]});
             });
             return;
         }
         mEdgeTree.overlappingPairs(mEdgeTree, eeTasks[k - vtTasks.size()], [&](int e, int f) {
-            const auto& ea = mEdges[e];
-            const auto& eb = mEdges[f];
-            if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
-            if (held(ea[0], ea[1], eb[0], eb[1])) return;
-            // Strand against strand (hair has no triangles): not modelled.
-            if (!mBodyHasTriangles[mVertexBody[ea[0]]] && !mBodyHasTriangles[mVertexBody[eb[0]]])
-                return;
-            out.push_back({ea[0], ea[1], eb[0], eb[1]});
+            if (candidateEdgeEdge(e, f))
+                out.push_back({mEdges[e][0], mEdges[e][1], mEdges[f][0], mEdges[f][1]});
         });
     });
     const auto concatenate = [&](size_t begin, size_t end, std::vector<Candidate>& all) {
@@ -258,6 +247,23 @@ void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
     };
     concatenate(0, vtTasks.size(), vtOut);
     concatenate(vtTasks.size(), parts.size(), eeOut);
+}
+
+bool SelfCollision::candidateVertexTriangle(int vi, int t) const {
+    const auto& tri = mTris[t];
+    if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return false;
+    return !(mInvMass[vi] == 0.0 && mInvMass[tri[0]] == 0.0 && mInvMass[tri[1]] == 0.0 &&
+             mInvMass[tri[2]] == 0.0);
+}
+
+bool SelfCollision::candidateEdgeEdge(int e, int f) const {
+    const auto& ea = mEdges[e];
+    const auto& eb = mEdges[f];
+    if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return false;
+    if (mInvMass[ea[0]] == 0.0 && mInvMass[ea[1]] == 0.0 && mInvMass[eb[0]] == 0.0 &&
+        mInvMass[eb[1]] == 0.0)
+        return false;
+    return mBodyHasTriangles[mVertexBody[ea[0]]] || mBodyHasTriangles[mVertexBody[eb[0]]];
 }
 
 double SelfCollision::relativeMotionBound(const Pair& p, bool vertexTriangle) const {
@@ -464,9 +470,6 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
     };
     mCandVt.erase(std::remove_if(mCandVt.begin(), mCandVt.end(), touches), mCandVt.end());
     mCandEe.erase(std::remove_if(mCandEe.begin(), mCandEe.end(), touches), mCandEe.end());
-    const auto held = [&](int a, int b, int c, int d) {
-        return mInvMass[a] == 0.0 && mInvMass[b] == 0.0 && mInvMass[c] == 0.0 && mInvMass[d] == 0.0;
-    };
     // Vertex–triangle: the moved vertices against every triangle, then the triangles with a
     // moved corner against the unmoved vertices (each new pair once).
     std::vector<int> movedVerts, movedTris, movedEdges;
@@ -482,10 +485,8 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
             movedEdges.push_back(static_cast<int>(e));
         }
     const auto vertexTriangle = [&](int vi, int t, std::vector<Candidate>& out) {
-        const auto& tri = mTris[t];
-        if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return;
-        if (held(vi, tri[0], tri[1], tri[2])) return;
-        out.push_back({vi, tri[0], tri[1], tri[2]});
+        if (candidateVertexTriangle(vi, t))
+            out.push_back({vi, mTris[t][0], mTris[t][1], mTris[t][2]});
     };
     const size_t nv = movedVerts.size(), nt = movedTris.size();
     const std::vector<Candidate> vt =
@@ -505,16 +506,10 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
     const std::vector<Candidate> ee =
         parallelCollect<Candidate>(movedEdges.size(), [&](size_t k, std::vector<Candidate>& out) {
             const int e = movedEdges[k];
-            const auto& ea = mEdges[e];
             mEdgeTree.queryEach(mEdgeBoxes[e], [&](int f) {
                 if (edgeMoved[f] && f <= e) return;
-                const auto& eb = mEdges[f];
-                if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return;
-                if (held(ea[0], ea[1], eb[0], eb[1])) return;
-                if (!mBodyHasTriangles[mVertexBody[ea[0]]] &&
-                    !mBodyHasTriangles[mVertexBody[eb[0]]])
-                    return;
-                out.push_back({ea[0], ea[1], eb[0], eb[1]});
+                if (candidateEdgeEdge(e, f))
+                    out.push_back({mEdges[e][0], mEdges[e][1], mEdges[f][0], mEdges[f][1]});
             });
         });
     mCandEe.insert(mCandEe.end(), ee.begin(), ee.end());

@@ -89,6 +89,11 @@ private:
     // memory the broad phase writes and the narrow phase reads: 16 bytes, not 48).
     using Candidate = std::array<int, 4>;
     void gatherCandidates(std::vector<Candidate>& vt, std::vector<Candidate>& ee) const;
+    // Vertex vi against triangle t, and edge e against edge f, as candidates when their boxes
+    // overlap: false for primitives sharing a vertex, for four held vertices (nothing can move),
+    // and for strand against strand (hair has no triangles: not modelled).
+    bool candidateVertexTriangle(int vi, int t) const;
+    bool candidateEdgeEdge(int e, int f) const;
     // The candidates again after the vertices marked in `moved` (and only they) moved beyond
     // the allowance: the pairs of unmoved vertices kept, those with a moved one queried anew.
     void regatherMoved(const std::vector<uint8_t>& moved);
