@@ -92,3 +92,35 @@ TEST_CASE("PLY property names are made unique and free of spaces and controls",
         CHECK(back.columns[2][0] == 3);
     }
 }
+
+// fuzz_readers: an element declared with a huge count and no properties was walked one
+// (empty) element at a time, 4.8e18 of them: a hang. It holds no bytes; the elements after it
+// read as written.
+TEST_CASE("a PLY element without properties holds no data, whatever its count",
+          "[fuzz][pointset][ply]") {
+    for (const char* format : {"ascii", "binary_little_endian"}) {
+        std::string text = std::string("ply\nformat ") + format +
+                           " 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement marker 4766666666666666666\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        if (std::string(format) == "ascii") {
+            text += "0 0 0\n1 0 0\n0 1 0\n3 2 1 0\n";
+        } else {
+            text.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+            const unsigned char n = 3;
+            const int idx[3] = {2, 1, 0};
+            text.append(reinterpret_cast<const char*>(&n), 1);
+            text.append(reinterpret_cast<const char*>(idx), sizeof idx);
+        }
+        std::istringstream in(text);
+        PointSet ps;
+        IoError e = readPointsPly(in, "marker.ply", ps);
+        INFO(format << ": " << e.render());
+        REQUIRE(!e);
+        REQUIRE(ps.size() == 3);
+        CHECK(ps.columns[1][2] == 1);
+        REQUIRE(ps.faces.size() == 1);
+        CHECK(ps.faces[0] == std::vector<int>{2, 1, 0});
+    }
+}

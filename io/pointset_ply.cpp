@@ -384,6 +384,9 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
         }
         bool isVertex = &e == vertex;
         if (isVertex) out.columns.assign(out.names.size(), std::vector<double>(e.count));
+        // An element without properties holds no bytes, whatever its count says (a fuzzed
+        // header declared 4.8e18 of them: walking them one by one never ended).
+        if (e.props.empty()) continue;
 
         for (size_t i = 0; i < e.count; ++i) {
             for (const PlyProperty& p : e.props) {
