@@ -314,7 +314,7 @@ void Body::evaluateKinematics(const Environment& env, double t, double h) {
         m.thickness = colliderThickness(c);
         // A moving mesh's tree for the step (moving_collider.h), searched far enough to find
         // the surface a vertex within the thickness of it is moving towards.
-        if (c.moving) c.moving->prepare(mKin.t0, mKin.t1, m.thickness);
+        if (c.moving) c.moving->prepare(mKin.t0, mKin.t1);
         m.start = colliderPose(c, mKin.t0);
         m.end = colliderPose(c, mKin.t1);
         if (c.moving) {

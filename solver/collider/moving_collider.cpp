@@ -101,8 +101,8 @@ Vec3 MovingMeshContact::faceNormal(bool atEnd, int tri) const {
     return l > 0.0 ? Vec3(n / l) : Vec3::UnitY();
 }
 
-void MovingMeshContact::prepare(double t0, double t1, double margin) {
-    if (mBuilt && t0 == mT0 && t1 == mT1 && margin == mMargin) return;
+void MovingMeshContact::prepare(double t0, double t1) {
+    if (mBuilt && t0 == mT0 && t1 == mT1) return;
     const auto start = std::chrono::steady_clock::now();
     if (!(mBuilt && t0 == mT1))
         mMesh->positionsAt(t0, mP0);
@@ -111,15 +111,17 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
     mMesh->positionsAt(t1, mP1);
     mT0 = t0;
     mT1 = t1;
-    mMargin = margin;
-    // A primitive's box over the step: its corners at both ends, inflated by the margin.
+    // The body's mean displacement over the step: the trees' frame moves with it (mShift).
+    Vec3 shift = Vec3::Zero();
+    for (int v : mVertices) shift += corner(true, v) - corner(false, v);
+    mShift = mVertices.empty() ? Vec3::Zero() : Vec3(shift / static_cast<double>(mVertices.size()));
+    if (!mShift.allFinite()) mShift.setZero();
+    // A primitive's box over the step in that frame: its corners at both ends. Not inflated:
+    // every query inflates its own box by its reach (a thickness, a search radius), which is
+    // enough (two boxes within the reach of each other are what a pair within it needs).
     const auto sweptBox = [&](const int* v, int count) {
         contact::Box b;
-        for (int c = 0; c < count; ++c) {
-            b.add(corner(false, v[c]));
-            b.add(corner(true, v[c]));
-        }
-        b.inflate(margin);
+        for (int c = 0; c < count; ++c) addSwept(b, corner(false, v[c]), corner(true, v[c]));
         return b;
     };
     const auto& tris = mMesh->triangles();
@@ -139,11 +141,12 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
         mEdgeBvh.build(mEdgeBoxes);
         mVertexBvh.build(mVertexBoxes);
         mBuilt = true;
-    } else {
-        mBvh.refit(mBoxes);
-        mEdgeBvh.refit(mEdgeBoxes);
-        mVertexBvh.refit(mVertexBoxes);
+        mStats.buildSeconds += seconds(start);
+        return;
     }
+    mBvh.refit(mBoxes);
+    mEdgeBvh.refit(mEdgeBoxes);
+    mVertexBvh.refit(mVertexBoxes);
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
 }
@@ -151,8 +154,11 @@ void MovingMeshContact::prepare(double t0, double t1, double margin) {
 bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const {
     out.distance = INFINITY;
     if (!mBuilt) return false;
+    // The tree's boxes hold each triangle at t0 and at t1 in the frame moving with the body:
+    // a query at the end is made there too.
+    const Vec3 xq = atEnd ? endQuery(x) : x;
     contact::Box q;
-    q.add(x);
+    q.add(xq);
     q.inflate(radius);
     double best = radius * radius;
     int bestTri = -1;
@@ -160,12 +166,12 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     const auto& tris = mMesh->triangles();
     // A nearest-point walk: a node or triangle whose box is farther than the best distance so
     // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
-    // it is skipped; the rest is visited in the order of a plain box query, so the result is the
-    // same. `slack` covers the rounding of the distances (about 16ε of |x|², far below it).
+    // it is skipped; the closer child first. The lowest (distance, triangle) pair is kept, so the
+    // result does not depend on the order of the visits. The slack covers the rounding of the
+    // distances (about 16ε of |x|², far below it).
     auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
-    mBvh.traverse([&](const contact::Box& b) { return b.overlaps(q) && b.distance2(x) <= reach(); },
-                  [&](int k, const contact::Box& b) {
-                      if (!b.overlaps(q) || b.distance2(x) > reach()) return;
+    mBvh.nearestFirst([&](const contact::Box& b) { return b.overlaps(q) ? b.distance2(xq) : INFINITY; },
+                      reach, [&](int k, const contact::Box&) {
                       double w[3];
                       const double d2 = contact::pointTriangleDistance2(
                           x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]),
@@ -204,7 +210,16 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     q.inflate(radius);
     double best = radius * radius;
     int bestVertex = -1;
-    mVertexBvh.queryEach(q, [&](int k) {
+    // Nearest first, as closest(): the box of the triangle against the vertices' boxes bounds
+    // the distance from below; the lowest (distance, vertex) pair is kept.
+    contact::Box tb;
+    tb.add(a);
+    tb.add(b);
+    tb.add(c);
+    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
+    mVertexBvh.nearestFirst(
+        [&](const contact::Box& box) { return box.overlaps(q) ? box.distance2(tb) : INFINITY; },
+        reach, [&](int k, const contact::Box&) {
         const int v = mVertices[k];
         double wk[3];
         const double d2 = contact::pointTriangleDistance2(corner(false, v), a, b, c, wk);
@@ -302,13 +317,13 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
-            q.add(p0);
-            q.add(p1);
+            addSwept(q, p0, p1);
             q.inflate(thickness);
             double first = 2.0;
             int hitTri = -1;
             cand.clear();
             mBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            std::sort(cand.begin(), cand.end()); // triangle order: a fixed tie-break
             mStats.broadSeconds += seconds(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = std::chrono::steady_clock::now();
@@ -369,16 +384,14 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
-            q.add(a0);
-            q.add(a1);
-            q.add(b0);
-            q.add(b1);
+            addSwept(q, a0, a1);
+            addSwept(q, b0, b1);
             q.inflate(thickness);
             cand.clear();
             // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
             // of the triangles reached whose boxes do not are farther than the thickness from
-            // the cloth edge throughout the step (their boxes are inflated by the margin, the
-            // query by the thickness, and CCD asks for half of it), so they cannot be hit.
+            // the cloth edge throughout the step (the query's box is inflated by it, and CCD
+            // asks for half of it), so they cannot be hit.
             mEdgeBvh.queryEach(q, [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end());
             mStats.broadSeconds += seconds(tb);
@@ -466,10 +479,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const double wantT = placedAt(xiT);
             auto tb = std::chrono::steady_clock::now();
             contact::Box q;
-            for (int k = 0; k < 3; ++k) {
-                q.add(c0[k]);
-                q.add(c1[k]);
-            }
+            for (int k = 0; k < 3; ++k) addSwept(q, c0[k], c1[k]);
             q.inflate(thickness);
             cand.clear();
             mVertexBvh.queryEach(q, [&](int k) { cand.push_back(k); });

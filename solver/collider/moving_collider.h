@@ -22,8 +22,11 @@ struct ContactPoint; // collider.h
 // Timings and counts of the contact work (accumulated; bench and run statistics). The body
 // vertex–cloth triangle pair's share is counted apart as well (`faceSeconds`, its broad and
 // narrow phase, and `faceCandidates` are also in the totals).
+// The first prepare() builds the trees (`buildSeconds`, once); every later one refits them
+// (`refitSeconds` over `refits`).
 struct MovingContactStats {
-    double refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0, faceSeconds = 0.0;
+    double buildSeconds = 0.0, refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0,
+           faceSeconds = 0.0;
     long long refits = 0, candidates = 0, faceCandidates = 0, vertexHits = 0, edgeHits = 0,
               faceHits = 0, unresolved = 0;
 };
@@ -33,9 +36,10 @@ public:
     explicit MovingMeshContact(std::shared_ptr<const MeshSequence> mesh);
 
     const MeshSequence& mesh() const { return *mMesh; }
-    // The step [t0, t1]: corners at both ends, swept triangle boxes inflated by `margin` (m),
-    // the tree refitted (built on the first call). Cached: the same interval twice is free.
-    void prepare(double t0, double t1, double margin);
+    // The step [t0, t1]: corners at both ends, the swept boxes of the triangles, edges and
+    // vertices, the trees refitted (built on the first call). Cached: the same interval twice
+    // is free.
+    void prepare(double t0, double t1);
     double t0() const { return mT0; }
     double t1() const { return mT1; }
 
@@ -70,18 +74,32 @@ public:
 
 private:
     Vec3 corner(bool atEnd, int v) const;
+    // A point's box over the step in the trees' frame: p0 at the start, p1 at the end (world
+    // positions).
+    void addSwept(contact::Box& b, const Vec3& p0, const Vec3& p1) const {
+        b.add(p0);
+        b.add(p1 - mShift);
+    }
+    // A point at the step's end (world) in the trees' frame.
+    Vec3 endQuery(const Vec3& x) const { return x - mShift; }
     Vec3 faceNormal(bool atEnd, int tri) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
     std::vector<std::array<int, 2>> mEdges; // unique body edges
     std::vector<int> mVertices;             // body vertices in some triangle
     std::vector<double> mP0, mP1;           // corners at t0 and t1
+    // The body's mean displacement over the step (m). The trees hold every primitive swept in
+    // the frame that moves with it (corners at t0, and at t1 less mShift) and queries are made
+    // in that frame too (swept(), endQuery()): a common motion linear in time changes no
+    // distance between two linearly moving points, so the boxes stay conservative, and a cloth
+    // riding on a body that travels d per step sweeps a box of its relative motion, not of d.
+    Vec3 mShift = Vec3::Zero();
     std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
     std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
     std::vector<contact::Box> mVertexBoxes; // per entry of mVertices, swept over the step
     contact::Bvh mBvh, mEdgeBvh, mVertexBvh;
     bool mBuilt = false;
-    double mT0 = NAN, mT1 = NAN, mMargin = NAN;
+    double mT0 = NAN, mT1 = NAN;
     MovingContactStats mStats;
 };
 

@@ -126,7 +126,7 @@ Outcome run(const Solid& solid, double silhouette, const Vec3& start, int frames
 TEST_CASE("moving mesh: closest points carry the surface velocity", "[collider][moving]") {
     const Solid s = box(0.5, 0.5, 0.5);
     MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(0, 0, 2.4), 3, 24.0));
-    m.prepare(0.0, 1.0 / 24.0, 0.01);
+    m.prepare(0.0, 1.0 / 24.0);
     ContactPoint cp;
     REQUIRE(m.closest(Vec3(0.1, 0.2, 0.503), false, 0.01, cp));
     CHECK(cp.distance == Approx(0.003));
@@ -365,7 +365,7 @@ TEST_CASE("moving mesh: a root pinned within the thickness does not throw its se
     const std::vector<uint8_t> movable = {0, 1};
     SECTION("a ridge rising under a root 0.55 ξ above it") {
         MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(0, 0.1 * xi / h, 0), 3, 24.0));
-        m.prepare(0.0, h, xi);
+        m.prepare(0.0, h);
         VecX x0(6);
         x0 << 0.0, 0.05 + 0.55 * xi, 0.0998, 0.0, 0.05 + 0.55 * xi - 0.002, 0.1198;
         VecX x1 = x0, v1 = VecX::Zero(6);
@@ -380,7 +380,7 @@ TEST_CASE("moving mesh: a root pinned within the thickness does not throw its se
     }
     SECTION("a box sliding under a root on its face") {
         MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(0.002 / h, 0, 0), 3, 24.0));
-        m.prepare(0.0, h, xi);
+        m.prepare(0.0, h);
         VecX x0(6);
         x0 << 0.001, 0.05, 0.0, 0.006, 0.07, 0.0; // the root on the diagonal's path
         VecX x1 = x0, v1 = VecX::Zero(6);
