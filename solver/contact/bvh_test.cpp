@@ -173,3 +173,75 @@ TEST_CASE("bvh: the pair walk split into tasks gives the whole walk's pairs in i
     empty.build({});
     CHECK(empty.pairTasks(ta, 8).empty());
 }
+
+TEST_CASE("bvh: the nearest-first walk finds the lowest (distance, index) of brute force",
+          "[contact][bvh]") {
+    // Points (degenerate boxes, many at equal distances from the grid queries below) and small
+    // boxes; the search keeps the lowest (distance², primitive) pair as closest() does.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    for (double size : {0.0, 0.01}) {
+        std::vector<Box> boxes(4000);
+        for (size_t i = 0; i < boxes.size(); ++i) {
+            // Half on a coarse lattice (ties), half uniform.
+            const Eigen::Vector3d c = i % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
+                                            : Eigen::Vector3d(std::floor(10 * U(rng)) / 10,
+                                                              std::floor(10 * U(rng)) / 10,
+                                                              std::floor(10 * U(rng)) / 10);
+            boxes[i].add(c);
+            boxes[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+        }
+        Bvh bvh;
+        bvh.build(boxes);
+        size_t nearestVisits = 0, plainVisits = 0;
+        for (int q = 0; q < 200; ++q) {
+            const Eigen::Vector3d p = q % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
+                                            : Eigen::Vector3d(0.05 + std::floor(10 * U(rng)) / 10,
+                                                              std::floor(10 * U(rng)) / 10,
+                                                              std::floor(10 * U(rng)) / 10);
+            const double radius2 = 0.2 * 0.2;
+            double want = radius2;
+            int wantIndex = -1;
+            for (int i = 0; i < static_cast<int>(boxes.size()); ++i) {
+                const double d = boxes[i].distance2(p);
+                if (d < want || (d == want && wantIndex >= 0 && i < wantIndex)) {
+                    want = d;
+                    wantIndex = i;
+                }
+            }
+            double best = radius2;
+            int bestIndex = -1;
+            nearestVisits += bvh.nearestFirst([&](const Box& b) { return b.distance2(p); },
+                                              [&] { return best; },
+                                              [&](int i, const Box& b) {
+                                                  const double d = b.distance2(p);
+                                                  if (d < best || (d == best && bestIndex >= 0 &&
+                                                                   i < bestIndex)) {
+                                                      best = d;
+                                                      bestIndex = i;
+                                                  }
+                                              });
+            CHECK(bestIndex == wantIndex);
+            CHECK(best == want);
+            // The same search as a plain walk in query order, pruned by the best so far.
+            double plainBest = radius2;
+            plainVisits += bvh.traverse([&](const Box& b) { return b.distance2(p) <= plainBest; },
+                                        [&](int, const Box& b) {
+                                            plainBest = std::min(plainBest, b.distance2(p));
+                                        });
+            CHECK(plainBest == want);
+        }
+        INFO("box size " << size << ": nodes visited nearest-first " << nearestVisits
+                         << ", in query order " << plainVisits);
+        CHECK(nearestVisits < plainVisits); // the closer child first shrinks the bound earlier
+    }
+    Box a, b;
+    a.add(Eigen::Vector3d(0, 0, 0));
+    a.add(Eigen::Vector3d(1, 1, 1));
+    b.add(Eigen::Vector3d(2, 0.5, 3));
+    b.add(Eigen::Vector3d(4, 0.7, 5));
+    CHECK(a.distance2(b) == Approx(1.0 + 4.0)); // gaps 1 (x) and 2 (z)
+    CHECK(b.distance2(a) == a.distance2(b));
+    b.add(Eigen::Vector3d(0.5, 0.5, 0.5));
+    CHECK(a.distance2(b) == 0.0); // overlapping
+}
