@@ -75,6 +75,7 @@ Run ballRun(const Sphere& ball, int res, int substeps, double thickness, int fra
     c.shape = ColliderShape::Mesh;
     c.thickness = thickness;
     c.moving = std::make_shared<MovingMeshContact>(flying(ball, -0.35, 5.0, frames + 1, fps));
+    c.moving->setDetailedTiming(true);
     ClothMaterial mat;
     auto cloth =
         std::make_unique<Cloth>("sheet", makeGrid(0.6, 0.6, res, res, Vec3(-0.3, -0.3, 0.0)), mat);
@@ -122,6 +123,8 @@ int sceneRun(const std::string& path, const std::vector<std::string>& sets) {
         std::fprintf(stderr, "%s\n", err.text().c_str());
         return 1;
     }
+    for (const Collider& c : sim.world().colliders())
+        if (c.moving) c.moving->setDetailedTiming(true);
     double wall = 0.0;
     int substeps = 0;
     for (int f = sim.first() + 1; f <= sim.last(); ++f) {

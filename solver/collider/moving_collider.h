@@ -23,10 +23,12 @@ struct ContactPoint; // collider.h
 // vertex–cloth triangle pair's share is counted apart as well (`faceSeconds`, its broad and
 // narrow phase, and `faceCandidates` are also in the totals).
 // The first prepare() builds the trees (`buildSeconds`, once); every later one refits them
-// (`refitSeconds` over `refits`).
+// (`refitSeconds` over `refits`). `sweepSeconds`: the continuous passes, always; the split into
+// broad and narrow phase and the face pair's share only with setDetailedTiming (a clock read per
+// primitive).
 struct MovingContactStats {
-    double buildSeconds = 0.0, refitSeconds = 0.0, broadSeconds = 0.0, narrowSeconds = 0.0,
-           faceSeconds = 0.0;
+    double buildSeconds = 0.0, refitSeconds = 0.0, sweepSeconds = 0.0, broadSeconds = 0.0,
+           narrowSeconds = 0.0, faceSeconds = 0.0;
     long long refits = 0, candidates = 0, faceCandidates = 0, vertexHits = 0, edgeHits = 0,
               faceHits = 0, unresolved = 0;
 };
@@ -71,6 +73,8 @@ public:
               double h, int passes = 4);
 
     const MovingContactStats& stats() const { return mStats; }
+    // Clock the broad and narrow phase of every primitive (MovingContactStats; benchmarks).
+    void setDetailedTiming(bool on) { mDetailedTiming = on; }
 
 private:
     Vec3 corner(bool atEnd, int v) const;
@@ -99,6 +103,7 @@ private:
     std::vector<contact::Box> mVertexBoxes; // per entry of mVertices, swept over the step
     contact::Bvh mBvh, mEdgeBvh, mVertexBvh;
     bool mBuilt = false;
+    bool mDetailedTiming = false;
     double mT0 = NAN, mT1 = NAN;
     MovingContactStats mStats;
 };

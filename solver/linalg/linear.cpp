@@ -446,21 +446,25 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
             for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
                 band = std::max(band, std::abs(A.blockCols()[k] - i));
         if (band <= kBandedOrder) {
-            mLdltBanded = std::make_unique<
-                Eigen::SimplicialLDLT<ColMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>>>();
-            mLdltBanded->analyzePattern(mFilteredA);
+            mLdltBanded = std::make_unique<BandedLdlt>();
+            mLdltBanded->analyze(mFilteredA);
         } else {
             mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
             mLdlt->analyzePattern(mFilteredA);
         }
     }
-    const auto factorSolve = [&](auto& ldlt) {
-        ldlt.factorize(mFilteredA);
-        if (ldlt.info() != Eigen::Success) return false;
-        y = ldlt.solve(rhs);
+    const auto factorSolve = [&]() {
+        if (mLdltBanded) {
+            if (!mLdltBanded->factorize(mFilteredA)) return false;
+            mLdltBanded->solve(rhs, y);
+            return true;
+        }
+        mLdlt->factorize(mFilteredA);
+        if (mLdlt->info() != Eigen::Success) return false;
+        y = mLdlt->solve(rhs);
         return true;
     };
-    if (!(mLdltBanded ? factorSolve(*mLdltBanded) : factorSolve(*mLdlt))) {
+    if (!factorSolve()) {
         st.failed = true;
         return st;
     }

@@ -5,6 +5,7 @@
 // throwing.
 #pragma once
 
+#include "solver/linalg/banded_ldlt.h"
 #include "solver/linalg/multigrid.h"
 #include "solver/linalg/types.h"
 
@@ -158,10 +159,10 @@ private:
     ColMatrix mFilteredA;
     std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix>> mLdlt; // fill-reducing (AMD) order
     // A banded matrix (hair: each vertex coupled to its strand's next two) in its own order: no
-    // fill outside the band, and no permuted copy of the matrix per factorisation (Eigen's AMD
-    // path copies it, permute_symm_to_symm: 8 % of examples/10_hair_turn's time).
-    std::unique_ptr<Eigen::SimplicialLDLT<ColMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>>>
-        mLdltBanded;
+    // fill outside the band, no permuted copy of the matrix per factorisation (Eigen's AMD path
+    // copies it, permute_symm_to_symm: 8 % of examples/10_hair_turn's time), and only the
+    // strands whose filtered values changed refactored (the contact active set's rounds).
+    std::unique_ptr<BandedLdlt> mLdltBanded;
 };
 
 } // namespace gale::solver

@@ -1,0 +1,63 @@
+// A banded LDLᵀ factorisation of a symmetric positive definite sparse matrix in its natural
+// order (hair: each strand a band, strands uncoupled), refactorising only the independent
+// diagonal blocks whose values changed since the last factorisation.
+#pragma once
+
+#include <Eigen/SparseCore>
+
+#include <vector>
+
+namespace gale::solver {
+
+// For A with half-bandwidth w (A_ij = 0 when |i − j| > w), A = L D Lᵀ, L unit lower triangular
+// with the same band, D diagonal (Golub & Van Loan, "Matrix Computations", 4th ed., §4.3.5:
+// band Cholesky; here its LDLᵀ form, no square roots), row by row:
+//   L_ij = (A_ij − Σ_{k<j} L_ik D_k L_jk) / D_j     (i − w ≤ j < i)
+//   D_i  =  A_ii − Σ_{k<i} L_ik² D_k
+// with k over the band only, in O(n w²) operations. The rows split into components: ranges
+// [b, e) with no entry coupling them to another (a strand of hair). A component's factor
+// depends on its own values only, so a factorisation after a change in a few components (the
+// contact active set's rounds: a vertex's filter changed) recomputes those and keeps the others,
+// the same bits as a full factorisation.
+class BandedLdlt {
+public:
+    using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor>;
+
+    // The band and the components of A's pattern (symmetric; its lower triangle is read).
+    // Returns false when A is not square. Forgets any factor.
+    bool analyze(const Matrix& A);
+    int halfBandwidth() const { return mW; }
+    int components() const { return static_cast<int>(mStart.size()) - 1; }
+
+    // Factors A (the analysed pattern, any values): the components whose values differ from the
+    // last successful factorisation's. False when a pivot D_i is not positive and finite (A not
+    // SPD, or not finite): nothing is then kept and the next call factors every component.
+    bool factorize(const Matrix& A);
+    // Components refactored by the last factorize().
+    int lastRefactored() const { return mRefactored; }
+
+    // x = A⁻¹ b with the last factor (b and x may be the same vector).
+    void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+
+private:
+    // Band storage: row i's entries A_i,i−w .. A_ii at mA[i (w + 1) + (j − i + w)]; the same
+    // layout holds L (strictly lower part) and D (the diagonal slot).
+    double& band(std::vector<double>& v, int i, int j) const {
+        return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
+    }
+    double band(const std::vector<double>& v, int i, int j) const {
+        return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
+    }
+    bool factorComponent(int c);
+
+    int mN = 0, mW = 0;
+    std::vector<int> mStart;     // component c is rows [mStart[c], mStart[c + 1])
+    std::vector<double> mA;   // A's band as last factored
+    std::vector<double> mNew; // the band of the A being factored (scratch)
+    std::vector<double> mLd;  // the factor: L below the diagonal, D on it
+    std::vector<char> mValid; // per component: mLd holds its factor of mA
+    std::vector<double> mScratch;
+    int mRefactored = 0;
+};
+
+} // namespace gale::solver
