@@ -336,8 +336,16 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     mStickVelocity.setZero(3 * n);
     mContactMu.assign(n, 0.0);
     mFoundInside.assign(n, 0);
-    mEndBound.assign(n * mKin.colliders.size(), -1.0);
-    mEndAt.resize(3 * static_cast<Eigen::Index>(mEndBound.size()));
+    // The last substep's end-pose bounds hold at this one's start if it ended at t (the same
+    // pose of every collider: the same time, the same collider list).
+    const size_t slots = n * mKin.colliders.size();
+    const bool carried = mBoundTime == t && mEndBound.size() == slots;
+    mStartBound.swap(mEndBound);
+    mStartAt.swap(mEndAt);
+    if (!carried) mStartBound.assign(slots, -1.0);
+    mEndBound.assign(slots, -1.0);
+    mEndAt.resize(3 * static_cast<Eigen::Index>(slots));
+    mBoundTime = t + h; // the end pose's time, for the next substep
     // A is assembled anew for the substep: no friction in it.
     mFrictionDamping.assign(n, 0.0);
     mFrictionPrev.assign(2 * n, 0.0);
@@ -350,9 +358,15 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         const ColliderPose& pose = mKin.colliders[ci].start;
         // Vertices within 1.5 ξ of this collider's surface (its own contacts decide for them).
         std::vector<uint8_t> nearSurface(n, 0);
+        // The widest band a vertex is asked about below.
+        const double reach = thick + kContactBand * thick + kContactSlop;
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] != 0) continue; // pinned, held, or another collider's
             const Vec3 x = vec3At(mX.data(), i);
+            const size_t slot = ci * n + i;
+            if (mStartBound[slot] >= 0.0 &&
+                (x - vec3At(mStartAt.data(), slot)).norm() < mStartBound[slot] - reach)
+                continue; // farther than the band from the surface (1-Lipschitz distance)
             const ContactPoint cp = queryCollider(pose, x);
             nearSurface[i] = cp.distance < thick + kContactBand * thick + kContactSlop;
             // Touching at the end of the last substep: within a band above the thickness (a

@@ -386,6 +386,12 @@ private:
     // vertex that moved less than bound − ξ since cannot be within ξ: endPoseQuery()); −1 unknown.
     std::vector<double> mEndBound;
     VecX mEndAt;
+    // The same bounds carried to the next substep: its start pose is this one's end pose (time
+    // mBoundTime), so a vertex whose distance is known to exceed the contact band needs no query
+    // at the start either (contactConstraints).
+    std::vector<double> mStartBound;
+    VecX mStartAt;
+    double mBoundTime = NAN;
     std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)
     std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
     std::vector<double> mFrictionInA;     // per vertex: the c now added to A (kg) ...
