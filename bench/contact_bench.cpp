@@ -91,8 +91,10 @@ Run ballRun(const Sphere& ball, int res, int substeps, double thickness, int fra
     for (int f = 1; f <= frames; ++f) {
         FrameStats fs;
         const double s = seconds([&] { fs = world.advanceFrame(f); });
-        if (f == 1) r.firstFrame = s;
-        else total += s;
+        if (f == 1)
+            r.firstFrame = s;
+        else
+            total += s;
         r.substeps += fs.bodies[0].substeps;
         if (f > 1) r.laterSubsteps += fs.bodies[0].substeps;
         if (!withBody) continue;

@@ -170,18 +170,19 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     // result does not depend on the order of the visits. The slack covers the rounding of the
     // distances (about 16ε of |x|², far below it).
     auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
-    mBvh.nearestFirst([&](const contact::Box& b) { return b.overlaps(q) ? b.distance2(xq) : INFINITY; },
-                      reach, [&](int k, const contact::Box&) {
-                      double w[3];
-                      const double d2 = contact::pointTriangleDistance2(
-                          x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]),
-                          corner(atEnd, tris[k][2]), w);
-                      if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
-                          best = d2;
-                          bestTri = k;
-                          std::copy(w, w + 3, bestW);
-                      }
-                  });
+    mBvh.nearestFirst(
+        [&](const contact::Box& b) { return b.overlaps(q) ? b.distance2(xq) : INFINITY; }, reach,
+        [&](int k, const contact::Box&) {
+            double w[3];
+            const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[k][0]),
+                                                              corner(atEnd, tris[k][1]),
+                                                              corner(atEnd, tris[k][2]), w);
+            if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
+                best = d2;
+                bestTri = k;
+                std::copy(w, w + 3, bestW);
+            }
+        });
     if (bestTri < 0) return false;
     const auto& t = tris[bestTri];
     Vec3 p = Vec3::Zero(), v = Vec3::Zero();
@@ -219,16 +220,17 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
     mVertexBvh.nearestFirst(
         [&](const contact::Box& box) { return box.overlaps(q) ? box.distance2(tb) : INFINITY; },
-        reach, [&](int k, const contact::Box&) {
-        const int v = mVertices[k];
-        double wk[3];
-        const double d2 = contact::pointTriangleDistance2(corner(false, v), a, b, c, wk);
-        if (d2 < best || (d2 == best && bestVertex >= 0 && v < bestVertex)) {
-            best = d2;
-            bestVertex = v;
-            std::copy(wk, wk + 3, w);
-        }
-    });
+        reach,
+        [&](int k, const contact::Box&) {
+            const int v = mVertices[k];
+            double wk[3];
+            const double d2 = contact::pointTriangleDistance2(corner(false, v), a, b, c, wk);
+            if (d2 < best || (d2 == best && bestVertex >= 0 && v < bestVertex)) {
+                best = d2;
+                bestVertex = v;
+                std::copy(wk, wk + 3, w);
+            }
+        });
     if (bestVertex < 0) return false;
     p = corner(false, bestVertex);
     distance = std::sqrt(best);

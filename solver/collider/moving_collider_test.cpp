@@ -409,9 +409,9 @@ TEST_CASE("moving mesh: queries in the body's moving frame", "[collider][moving]
         const Vec3 c = atEnd ? Vec3(vel * h) : Vec3::Zero();
         for (const auto& t : s.tris) {
             double w[3];
-            d2 = std::min(d2, contact::pointTriangleDistance2(
-                                  x, vec3At(s.pos.data(), t[0]) + c, vec3At(s.pos.data(), t[1]) + c,
-                                  vec3At(s.pos.data(), t[2]) + c, w));
+            d2 = std::min(d2, contact::pointTriangleDistance2(x, vec3At(s.pos.data(), t[0]) + c,
+                                                              vec3At(s.pos.data(), t[1]) + c,
+                                                              vec3At(s.pos.data(), t[2]) + c, w));
         }
     };
     std::mt19937 rng(5);

@@ -184,10 +184,10 @@ TEST_CASE("bvh: the nearest-first walk finds the lowest (distance, index) of bru
         std::vector<Box> boxes(4000);
         for (size_t i = 0; i < boxes.size(); ++i) {
             // Half on a coarse lattice (ties), half uniform.
-            const Eigen::Vector3d c = i % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
-                                            : Eigen::Vector3d(std::floor(10 * U(rng)) / 10,
-                                                              std::floor(10 * U(rng)) / 10,
-                                                              std::floor(10 * U(rng)) / 10);
+            const Eigen::Vector3d c =
+                i % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
+                      : Eigen::Vector3d(std::floor(10 * U(rng)) / 10, std::floor(10 * U(rng)) / 10,
+                                        std::floor(10 * U(rng)) / 10);
             boxes[i].add(c);
             boxes[i].add(c + size * Eigen::Vector3d(U(rng), U(rng), U(rng)));
         }
@@ -195,10 +195,10 @@ TEST_CASE("bvh: the nearest-first walk finds the lowest (distance, index) of bru
         bvh.build(boxes);
         size_t nearestVisits = 0, plainVisits = 0;
         for (int q = 0; q < 200; ++q) {
-            const Eigen::Vector3d p = q % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
-                                            : Eigen::Vector3d(0.05 + std::floor(10 * U(rng)) / 10,
-                                                              std::floor(10 * U(rng)) / 10,
-                                                              std::floor(10 * U(rng)) / 10);
+            const Eigen::Vector3d p =
+                q % 2 ? Eigen::Vector3d(U(rng), U(rng), U(rng))
+                      : Eigen::Vector3d(0.05 + std::floor(10 * U(rng)) / 10,
+                                        std::floor(10 * U(rng)) / 10, std::floor(10 * U(rng)) / 10);
             const double radius2 = 0.2 * 0.2;
             double want = radius2;
             int wantIndex = -1;
@@ -211,24 +211,22 @@ TEST_CASE("bvh: the nearest-first walk finds the lowest (distance, index) of bru
             }
             double best = radius2;
             int bestIndex = -1;
-            nearestVisits += bvh.nearestFirst([&](const Box& b) { return b.distance2(p); },
-                                              [&] { return best; },
-                                              [&](int i, const Box& b) {
-                                                  const double d = b.distance2(p);
-                                                  if (d < best || (d == best && bestIndex >= 0 &&
-                                                                   i < bestIndex)) {
-                                                      best = d;
-                                                      bestIndex = i;
-                                                  }
-                                              });
+            nearestVisits += bvh.nearestFirst(
+                [&](const Box& b) { return b.distance2(p); }, [&] { return best; },
+                [&](int i, const Box& b) {
+                    const double d = b.distance2(p);
+                    if (d < best || (d == best && bestIndex >= 0 && i < bestIndex)) {
+                        best = d;
+                        bestIndex = i;
+                    }
+                });
             CHECK(bestIndex == wantIndex);
             CHECK(best == want);
             // The same search as a plain walk in query order, pruned by the best so far.
             double plainBest = radius2;
-            plainVisits += bvh.traverse([&](const Box& b) { return b.distance2(p) <= plainBest; },
-                                        [&](int, const Box& b) {
-                                            plainBest = std::min(plainBest, b.distance2(p));
-                                        });
+            plainVisits += bvh.traverse(
+                [&](const Box& b) { return b.distance2(p) <= plainBest; },
+                [&](int, const Box& b) { plainBest = std::min(plainBest, b.distance2(p)); });
             CHECK(plainBest == want);
         }
         INFO("box size " << size << ": nodes visited nearest-first " << nearestVisits

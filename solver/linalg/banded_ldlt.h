@@ -51,7 +51,7 @@ private:
     bool factorComponent(int c);
 
     int mN = 0, mW = 0;
-    std::vector<int> mStart;     // component c is rows [mStart[c], mStart[c + 1])
+    std::vector<int> mStart;  // component c is rows [mStart[c], mStart[c + 1])
     std::vector<double> mA;   // A's band as last factored
     std::vector<double> mNew; // the band of the A being factored (scratch)
     std::vector<double> mLd;  // the factor: L below the diagonal, D on it

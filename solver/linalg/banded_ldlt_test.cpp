@@ -38,7 +38,8 @@ BandedLdlt::Matrix sparse(const Eigen::MatrixXd& A) {
 
 } // namespace
 
-TEST_CASE("banded LDLT: solves like a dense LDLT, components from the pattern", "[linalg][banded]") {
+TEST_CASE("banded LDLT: solves like a dense LDLT, components from the pattern",
+          "[linalg][banded]") {
     std::mt19937 rng(4);
     const std::vector<int> lengths = {9, 15, 3, 30, 12};
     for (int w : {1, 5, 14}) {
@@ -49,9 +50,8 @@ TEST_CASE("banded LDLT: solves like a dense LDLT, components from the pattern", 
         CHECK(f.components() == static_cast<int>(lengths.size()));
         REQUIRE(f.factorize(sparse(A)));
         CHECK(f.lastRefactored() == static_cast<int>(lengths.size()));
-        Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(A.rows(), [&] {
-            return std::uniform_real_distribution<double>(-1, 1)(rng);
-        });
+        Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(
+            A.rows(), [&] { return std::uniform_real_distribution<double>(-1, 1)(rng); });
         Eigen::VectorXd x;
         f.solve(b, x);
         const Eigen::VectorXd want = A.ldlt().solve(b);
