@@ -117,11 +117,17 @@ bool Loader::number(const toml::node& n, const std::string& what, double& out, d
 
 bool Loader::integer(const toml::node& n, const std::string& what, long long& out, long long min) {
     long long v = 0;
+    const double d = n.value<double>().value_or(0.5);
     if (n.is_integer()) {
         v = n.value<long long>().value_or(0);
-    } else if (n.is_floating_point() && std::isfinite(n.value<double>().value_or(0.5)) &&
-               n.value<double>().value_or(0.5) == std::floor(n.value<double>().value_or(0.5))) {
-        v = static_cast<long long>(n.value<double>().value_or(0.0));
+    } else if (n.is_floating_point() && std::isfinite(d) && d == std::floor(d)) {
+        // A whole number written as a float (4.0, 1e3) — within what a long long holds (a
+        // fuzzed 41e300 was converted as is: undefined behaviour).
+        if (!(std::fabs(d) < 1e15)) {
+            error(n, what + " must be a whole number below 1e15, not " + io::formatNumber(d));
+            return false;
+        }
+        v = static_cast<long long>(d);
     } else {
         error(n, what + " must be a whole number, not " +
                      (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));

@@ -208,6 +208,24 @@ max_halvings = 2.5
     CHECK(all.find("max_halvings must be a whole number") != std::string::npos);
 }
 
+// fuzz_scene (UBSan): a whole number written as a huge float, 41e300, was converted to an
+// integer as is (undefined behaviour). Now an error at its line and column.
+TEST_CASE("scene: a whole number too large for an integer is an error", "[scene][fuzz]") {
+    TempDir dir;
+    Loaded l = load(dir, R"([[hair]]
+name = "tuft"
+grid = { size = [0.2, 0.2], count = [4, 41e300], length = 0.4, segments = 1e20 }
+)");
+    CHECK_FALSE(l.ok);
+    const std::string all = l.all();
+    INFO(all);
+    const std::string path = (dir.path / "scene.toml").string();
+    CHECK(all.find(path + ":3:41: error: [[hair]] 'tuft': grid count must be a whole number "
+                          "below 1e15, not 4.1e+301") != std::string::npos);
+    CHECK(all.find(path + ":3:75: error: [[hair]] 'tuft': grid segments must be a whole number "
+                          "below 1e15, not 1e+20") != std::string::npos);
+}
+
 TEST_CASE("scene: the response to trouble ([solver] retry keys) is read and checked", "[scene]") {
     TempDir dir;
     Loaded ok = load(dir, R"([[cloth]]

@@ -157,7 +157,7 @@ void Loader::loadSettings(const toml::table& t, SceneSettings& s) {
             if (last < first)
                 error(*n, "scene.frames: the last frame (" + std::to_string(last) +
                               ") comes before the first (" + std::to_string(first) + ")");
-            else if (std::llabs(first) > 100000000 || std::llabs(last) > 100000000)
+            else if (first < -100000000 || last > 100000000) // (no llabs: LLONG_MIN)
                 error(*n, "scene.frames: frame numbers must stay within +/-100000000");
             else {
                 s.frameStart = static_cast<int>(first);
