@@ -63,7 +63,6 @@ public:
 
 private:
     bool number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin);
-    bool integer(const toml::node& n, const std::string& what, long long& out, long long min);
     bool choice(const toml::node& n, const std::string& what, const std::vector<std::string>& options,
                 std::string& out);
     bool boolean(const toml::node& n, const std::string& what, bool& out);
@@ -109,32 +108,6 @@ bool Loader::number(const toml::node& n, const std::string& what, double& out, d
     if (strictMin ? !(v > min) : !(v >= min)) {
         error(n, what + " must be " + (strictMin ? "greater than " : "at least ") +
                      io::formatNumber(min) + ", not " + io::formatNumber(v));
-        return false;
-    }
-    out = v;
-    return true;
-}
-
-bool Loader::integer(const toml::node& n, const std::string& what, long long& out, long long min) {
-    long long v = 0;
-    const double d = n.value<double>().value_or(0.5);
-    if (n.is_integer()) {
-        v = n.value<long long>().value_or(0);
-    } else if (n.is_floating_point() && std::isfinite(d) && d == std::floor(d)) {
-        // A whole number written as a float (4.0, 1e3) — within what a long long holds (a
-        // fuzzed 41e300 was converted as is: undefined behaviour).
-        if (!(std::fabs(d) < 1e15)) {
-            error(n, what + " must be a whole number below 1e15, not " + io::formatNumber(d));
-            return false;
-        }
-        v = static_cast<long long>(d);
-    } else {
-        error(n, what + " must be a whole number, not " +
-                     (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
-        return false;
-    }
-    if (v < min) {
-        error(n, what + " must be at least " + std::to_string(min) + ", not " + std::to_string(v));
         return false;
     }
     out = v;

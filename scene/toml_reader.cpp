@@ -198,6 +198,36 @@ bool TomlReader::number(const toml::node& n, const std::string& what, double& ou
     return true;
 }
 
+bool TomlReader::integer(const toml::node& n, const std::string& what, long long& out,
+                         long long min) {
+    long long v = 0;
+    if (n.is_integer()) {
+        v = n.value<long long>().value_or(0);
+    } else if (n.is_floating_point()) {
+        double d = 0.0;
+        if (!number(n, what, d)) return false;
+        if (d != std::floor(d)) {
+            error(n, what + " must be a whole number, not a fraction");
+            return false;
+        }
+        // A fuzzed 41e300 was once converted as is: undefined behaviour.
+        if (!(std::fabs(d) < 1e15)) {
+            error(n, what + " must be a whole number below 1e15, not " + io::formatNumber(d));
+            return false;
+        }
+        v = static_cast<long long>(d);
+    } else {
+        error(n, what + " must be a whole number, not " + tomlTypeName(n));
+        return false;
+    }
+    if (v < min) {
+        error(n, what + " must be at least " + std::to_string(min) + ", not " + std::to_string(v));
+        return false;
+    }
+    out = v;
+    return true;
+}
+
 bool TomlReader::vectorValue(const toml::node& n, std::vector<double>& out) {
     out.clear();
     if (isTomlNumber(n)) {

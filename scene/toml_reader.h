@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -62,6 +63,10 @@ public:
     bool string(const toml::node& n, const std::string& what, std::string& out);
     // A finite number.
     bool number(const toml::node& n, const std::string& what, double& out);
+    // A whole number of at least `min`: an integer, or a float without a fraction below 1e15 in
+    // magnitude (4.0, 1e3; larger ones do not fit a long long exactly).
+    bool integer(const toml::node& n, const std::string& what, long long& out,
+                 long long min = std::numeric_limits<long long>::min());
     // A finite number or a non-empty array of finite numbers (up to the language's widest
     // vector); false without a report (the caller words the error).
     bool vectorValue(const toml::node& n, std::vector<double>& out);

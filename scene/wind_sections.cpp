@@ -41,7 +41,6 @@ public:
     void load(const toml::table& root, Scene& out);
 
 private:
-    bool integer(const toml::node& n, const std::string& what, long long& out);
     std::optional<Param> param(const toml::node& n, const std::string& what, int width);
     void verbatimPosition(const toml::node& n, const std::string& value, int& line, int& col) const;
 
@@ -70,21 +69,6 @@ void Loader::applySets(toml::table& root) {
 }
 
 // ---- Values -----------------------------------------------------------------------------------
-
-bool Loader::integer(const toml::node& n, const std::string& what, long long& out) {
-    double v = 0.0;
-    if (n.is_integer()) {
-        out = n.value<long long>().value_or(0);
-        return true;
-    }
-    if (n.is_floating_point() && number(n, what, v) && v == std::floor(v) && std::fabs(v) < 1e15) {
-        out = static_cast<long long>(v);
-        return true;
-    }
-    error(n, what + " must be a whole number, not " +
-                 (n.is_floating_point() ? std::string("a fraction") : tomlTypeName(n)));
-    return false;
-}
 
 // A numeric parameter: a number, a vector, or a keyframed curve. `width` 0 accepts any width.
 std::optional<Param> Loader::param(const toml::node& n, const std::string& what, int width) {
