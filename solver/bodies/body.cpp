@@ -358,7 +358,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         const ColliderPose& pose = mKin.colliders[ci].start;
         // Vertices within 1.5 ξ of this collider's surface (its own contacts decide for them).
         std::vector<uint8_t> nearSurface(n, 0);
-        // The widest band a vertex is asked about below.
+        // The band a vertex (and a body vertex near a triangle) is asked about below.
         const double reach = thick + kContactBand * thick + kContactSlop;
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] != 0) continue; // pinned, held, or another collider's
@@ -368,7 +368,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
                 (x - vec3At(mStartAt.data(), slot)).norm() < mStartBound[slot] - reach)
                 continue; // farther than the band from the surface (1-Lipschitz distance)
             const ContactPoint cp = queryCollider(pose, x);
-            nearSurface[i] = cp.distance < thick + kContactBand * thick + kContactSlop;
+            nearSurface[i] = cp.distance < reach;
             // Touching at the end of the last substep: within a band above the thickness (a
             // vertex that slid over a curved surface lifts off its tangent plane a little).
             const bool touched = i < mTouching.size() && mTouching[i];
@@ -404,9 +404,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             for (int k = 0; k < 3; ++k) corners[k] = vec3At(mX.data(), tri[k]);
             Vec3 p, vel;
             double w[3], dist;
-            if (!c.moving->nearestVertex(corners[0], corners[1], corners[2],
-                                         thick + kContactBand * thick + kContactSlop, p, w,
-                                         dist, vel) ||
+            if (!c.moving->nearestVertex(corners[0], corners[1], corners[2], reach, p, w, dist,
+                                         vel) ||
                 !(dist > 1e-12))
                 continue;
             const Vec3 q = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2];

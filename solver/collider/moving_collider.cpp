@@ -40,6 +40,13 @@
 namespace gale::solver {
 
 namespace {
+// A nearest-point search's bound on the squared distance still of interest, from the best so
+// far: the slack covers the rounding of the distances (about 16ε of |x|², far below it), so a
+// primitive at the same distance is still visited and the lowest index kept.
+double withSlack(double best2) {
+    return best2 * (1.0 + 1e-9) + 1e-18;
+}
+
 double seconds(std::chrono::steady_clock::time_point a) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
 }
@@ -157,9 +164,6 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     // The tree's boxes hold each triangle at t0 and at t1 in the frame moving with the body:
     // a query at the end is made there too.
     const Vec3 xq = atEnd ? endQuery(x) : x;
-    contact::Box q;
-    q.add(xq);
-    q.inflate(radius);
     double best = radius * radius;
     int bestTri = -1;
     double bestW[3] = {0, 0, 0};
@@ -167,11 +171,9 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     // A nearest-point walk: a node or triangle whose box is farther than the best distance so
     // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
     // it is skipped; the closer child first. The lowest (distance, triangle) pair is kept, so the
-    // result does not depend on the order of the visits. The slack covers the rounding of the
-    // distances (about 16ε of |x|², far below it).
-    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
+    // result does not depend on the order of the visits.
     mBvh.nearestFirst(
-        [&](const contact::Box& b) { return b.overlaps(q) ? b.distance2(xq) : INFINITY; }, reach,
+        [&](const contact::Box& b) { return b.distance2(xq); }, [&] { return withSlack(best); },
         [&](int k, const contact::Box&) {
             double w[3];
             const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[k][0]),
@@ -204,11 +206,6 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
                                       Vec3& p, double w[3], double& distance,
                                       Vec3& velocity) const {
     if (!mBuilt) return false;
-    contact::Box q;
-    q.add(a);
-    q.add(b);
-    q.add(c);
-    q.inflate(radius);
     double best = radius * radius;
     int bestVertex = -1;
     // Nearest first, as closest(): the box of the triangle against the vertices' boxes bounds
@@ -217,10 +214,8 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     tb.add(a);
     tb.add(b);
     tb.add(c);
-    auto reach = [&] { return best * (1.0 + 1e-9) + 1e-18; };
     mVertexBvh.nearestFirst(
-        [&](const contact::Box& box) { return box.overlaps(q) ? box.distance2(tb) : INFINITY; },
-        reach,
+        [&](const contact::Box& box) { return box.distance2(tb); }, [&] { return withSlack(best); },
         [&](int k, const contact::Box&) {
             const int v = mVertices[k];
             double wk[3];

@@ -45,9 +45,6 @@ private:
     double& band(std::vector<double>& v, int i, int j) const {
         return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
     }
-    double band(const std::vector<double>& v, int i, int j) const {
-        return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
-    }
     bool factorComponent(int c);
 
     int mN = 0, mW = 0;

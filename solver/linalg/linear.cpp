@@ -453,18 +453,16 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
             mLdlt->analyzePattern(mFilteredA);
         }
     }
-    const auto factorSolve = [&]() {
-        if (mLdltBanded) {
-            if (!mLdltBanded->factorize(mFilteredA)) return false;
-            mLdltBanded->solve(rhs, y);
-            return true;
-        }
+    bool ok;
+    if (mLdltBanded) {
+        ok = mLdltBanded->factorize(mFilteredA);
+        if (ok) mLdltBanded->solve(rhs, y);
+    } else {
         mLdlt->factorize(mFilteredA);
-        if (mLdlt->info() != Eigen::Success) return false;
-        y = mLdlt->solve(rhs);
-        return true;
-    };
-    if (!factorSolve()) {
+        ok = mLdlt->info() == Eigen::Success;
+        if (ok) y = mLdlt->solve(rhs);
+    }
+    if (!ok) {
         st.failed = true;
         return st;
     }
