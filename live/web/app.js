@@ -15,7 +15,7 @@ async function api(path, body) {
   return j;
 }
 
-const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null });
+const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null, simFramesDrawn: [], colliderTimes: [] });
 const view = new View($('view'));
 live.screenBox = (name) => view.screenBox(name);
 live.setTime = (t) => setTime(t);
@@ -142,6 +142,7 @@ async function showColliders(t) {
     view.setColliderPoses(c.colliders);
     colliderShown = t;
     live.colliderTime = t;
+    live.colliderTimes.push(t);
   } catch (e) {
     live.errors.push(String(e.message || e));
   } finally {
@@ -180,6 +181,7 @@ async function showSimFrame(f) {
       frameObjects = fr.objects;
       drawSimFrame();
       live.simFrameShown = n;
+      live.simFramesDrawn.push(n);
       live.simFrameRun = fr.run;
       showCompare(n);
     } else {
