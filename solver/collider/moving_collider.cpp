@@ -123,6 +123,21 @@ void MovingMeshContact::prepare(double t0, double t1) {
     for (int v : mVertices) shift += corner(true, v) - corner(false, v);
     mShift = mVertices.empty() ? Vec3::Zero() : Vec3(shift / static_cast<double>(mVertices.size()));
     if (!mShift.allFinite()) mShift.setZero();
+    if (mBuilt && treesStillHold()) {
+        ++mStats.kept;
+        mStats.refitSeconds += seconds(start);
+        return;
+    }
+    // (Re)fitted in this step's frame: the corners kept for treesStillHold().
+    mTreeOffset.setZero();
+    mTreeSlack = 0.0;
+    mRef0.resize(mP0.size());
+    mRef1.resize(mP1.size());
+    for (int v : mVertices) {
+        vec3At(mRef0.data(), v) = corner(false, v);
+        vec3At(mRef1.data(), v) = corner(true, v) - mShift;
+    }
+    const auto& tris = mMesh->triangles();
     // A primitive's box over the step in that frame: its corners at both ends. Not inflated:
     // every query inflates its own box by its reach (a thickness, a search radius), which is
     // enough (two boxes within the reach of each other are what a pair within it needs).
@@ -131,7 +146,6 @@ void MovingMeshContact::prepare(double t0, double t1) {
         for (int c = 0; c < count; ++c) addSwept(b, corner(false, v[c]), corner(true, v[c]));
         return b;
     };
-    const auto& tris = mMesh->triangles();
     mBoxes.resize(tris.size());
     for (size_t k = 0; k < tris.size(); ++k) mBoxes[k] = sweptBox(tris[k].data(), 3);
     // The body's edges get their own tree: an edge–edge query then meets only the edges whose
@@ -148,6 +162,12 @@ void MovingMeshContact::prepare(double t0, double t1) {
         mEdgeBvh.build(mEdgeBoxes);
         mVertexBvh.build(mVertexBoxes);
         mBuilt = true;
+        // The slack limit: a tenth of the body's mean edge length (every query reaches that
+        // much farther while the trees are kept).
+        double sum = 0.0;
+        for (const auto& e : mEdges) sum += (corner(false, e[0]) - corner(false, e[1])).norm();
+        mSlackLimit = mEdges.empty() ? 0.0 : 0.1 * sum / static_cast<double>(mEdges.size());
+        if (!std::isfinite(mSlackLimit)) mSlackLimit = 0.0;
         mStats.buildSeconds += seconds(start);
         return;
     }
@@ -156,6 +176,31 @@ void MovingMeshContact::prepare(double t0, double t1) {
     mVertexBvh.refit(mVertexBoxes);
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
+}
+
+// Every corner of this step in its moving frame (c at t0, and at t1 less mShift) against the
+// same corner r when the trees were refitted, carried by the offset o = mean(c₀ − r₀): a box
+// of the r corners inflated by max |c − o − r| holds the box of the c corners shifted by −o.
+bool MovingMeshContact::treesStillHold() {
+    if (!(mSlackLimit > 0.0) || mRef0.size() != mP0.size() || mVertices.empty()) return false;
+    Vec3 o = Vec3::Zero();
+    for (int v : mVertices) o += corner(false, v) - vec3At(mRef0.data(), v);
+    o /= static_cast<double>(mVertices.size());
+    if (!o.allFinite()) return false;
+    double slack2 = 0.0, scale = 0.0;
+    const double limit2 = mSlackLimit * mSlackLimit;
+    for (int v : mVertices) {
+        const Vec3 a = corner(false, v);
+        const Vec3 b = corner(true, v) - mShift;
+        slack2 = std::max({slack2, (a - o - vec3At(mRef0.data(), v)).squaredNorm(),
+                           (b - o - vec3At(mRef1.data(), v)).squaredNorm()});
+        if (!(slack2 <= limit2)) return false; // (NaN too)
+        scale = std::max(scale, a.cwiseAbs().maxCoeff());
+    }
+    // Rounded up: the differences above and the offset's subtraction in the queries.
+    mTreeSlack = std::sqrt(slack2) * (1.0 + 1e-9) + 1e-12 * std::max(scale, 1.0);
+    mTreeOffset = o;
+    return true;
 }
 
 bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const {
@@ -173,7 +218,8 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     // it is skipped; the closer child first. The lowest (distance, triangle) pair is kept, so the
     // result does not depend on the order of the visits.
     mBvh.nearestFirst(
-        [&](const contact::Box& b) { return b.distance2(xq); }, [&] { return withSlack(best); },
+        [&](const contact::Box& b) { return treeDistance2(b, xq); },
+        [&] { return withSlack(best); },
         [&](int k, const contact::Box&) {
             double w[3];
             const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[k][0]),
@@ -215,7 +261,8 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     tb.add(b);
     tb.add(c);
     mVertexBvh.nearestFirst(
-        [&](const contact::Box& box) { return box.distance2(tb); }, [&] { return withSlack(best); },
+        [&](const contact::Box& box) { return treeDistance2(box, tb); },
+        [&] { return withSlack(best); },
         [&](int k, const contact::Box&) {
             const int v = mVertices[k];
             double wk[3];
@@ -329,7 +376,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             double first = 2.0;
             int hitTri = -1;
             cand.clear();
-            mBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end()); // triangle order: a fixed tie-break
             mStats.broadSeconds += since(tb);
             mStats.candidates += static_cast<long long>(cand.size());
@@ -399,7 +446,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             // of the triangles reached whose boxes do not are farther than the thickness from
             // the cloth edge throughout the step (the query's box is inflated by it, and CCD
             // asks for half of it), so they cannot be hit.
-            mEdgeBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            mEdgeBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end());
             mStats.broadSeconds += since(tb);
             mStats.candidates += static_cast<long long>(cand.size());
@@ -489,7 +536,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             for (int k = 0; k < 3; ++k) addSwept(q, c0[k], c1[k]);
             q.inflate(thickness);
             cand.clear();
-            mVertexBvh.queryEach(q, [&](int k) { cand.push_back(k); });
+            mVertexBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end()); // body vertex order: a fixed tie-break
             const double broad = since(tb);
             mStats.broadSeconds += broad;

@@ -12,6 +12,7 @@
 #include "solver/linalg/types.h"
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -23,14 +24,15 @@ struct ContactPoint; // collider.h
 // vertex–cloth triangle pair's share is counted apart as well (`faceSeconds`, its broad and
 // narrow phase, and `faceCandidates` are also in the totals).
 // The first prepare() builds the trees (`buildSeconds`, once); every later one refits them
-// (`refitSeconds` over `refits`). `sweepSeconds`: the continuous passes, always; the split into
-// broad and narrow phase and the face pair's share only with setDetailedTiming (a clock read per
-// primitive).
+// (`refitSeconds` over `refits`), or keeps them where the body moved as one (`kept`: its
+// vertices within a slack of the trees' boxes carried by the body's translation). `sweepSeconds`:
+// the continuous passes, always; the split into broad and narrow phase and the face pair's share
+// only with setDetailedTiming (a clock read per primitive).
 struct MovingContactStats {
     double buildSeconds = 0.0, refitSeconds = 0.0, sweepSeconds = 0.0, broadSeconds = 0.0,
            narrowSeconds = 0.0, faceSeconds = 0.0;
-    long long refits = 0, candidates = 0, faceCandidates = 0, vertexHits = 0, edgeHits = 0,
-              faceHits = 0, unresolved = 0;
+    long long refits = 0, kept = 0, candidates = 0, faceCandidates = 0, vertexHits = 0,
+              edgeHits = 0, faceHits = 0, unresolved = 0;
 };
 
 class MovingMeshContact {
@@ -78,14 +80,39 @@ public:
 
 private:
     Vec3 corner(bool atEnd, int v) const;
-    // A point's box over the step in the trees' frame: p0 at the start, p1 at the end (world
-    // positions).
+    // A point's box over the step in the step's moving frame: p0 at the start, p1 at the end
+    // (world positions).
     void addSwept(contact::Box& b, const Vec3& p0, const Vec3& p1) const {
         b.add(p0);
         b.add(p1 - mShift);
     }
-    // A point at the step's end (world) in the trees' frame.
+    // A point at the step's end (world) in the step's moving frame.
     Vec3 endQuery(const Vec3& x) const { return x - mShift; }
+    // A query box of the step's moving frame in the trees' (mTreeOffset, mTreeSlack).
+    contact::Box inTrees(contact::Box q) const {
+        q.lo -= mTreeOffset;
+        q.hi -= mTreeOffset;
+        q.inflate(mTreeSlack);
+        return q;
+    }
+    // A lower bound on the squared distance from a point (or box) of the step's moving frame to
+    // whatever a tree box `b` holds.
+    double treeDistance2(const contact::Box& b, const Vec3& p) const {
+        return lessSlack(b.distance2(Vec3(p - mTreeOffset)));
+    }
+    double treeDistance2(const contact::Box& b, contact::Box q) const {
+        q.lo -= mTreeOffset;
+        q.hi -= mTreeOffset;
+        return lessSlack(b.distance2(q));
+    }
+    double lessSlack(double d2) const {
+        if (mTreeSlack == 0.0) return d2;
+        const double d = std::sqrt(d2) - mTreeSlack;
+        return d > 0.0 ? d * d : 0.0;
+    }
+    // Whether the trees' boxes, carried by the body's translation since their last refit, still
+    // hold every primitive of this step within the slack limit (then mTreeOffset, mTreeSlack).
+    bool treesStillHold();
     Vec3 faceNormal(bool atEnd, int tri) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
@@ -98,6 +125,17 @@ private:
     // distance between two linearly moving points, so the boxes stay conservative, and a cloth
     // riding on a body that travels d per step sweeps a box of its relative motion, not of d.
     Vec3 mShift = Vec3::Zero();
+    // The trees as last refitted: their step's corners in its moving frame (at t0, and at t1
+    // less that step's mShift), per vertex. A body that since moved as one (a rigid prop, a
+    // ball in flight: every vertex by the same displacement) has every primitive of this step
+    // within mTreeSlack (m) of its box there, carried by mTreeOffset (the mean displacement of
+    // the t0 corners since): the refit is skipped and every query made in the trees' frame
+    // (inTrees, treeDistance2), which gives the same candidates and results a refit would have
+    // (every box still conservative; the narrow phase reads the true corners). Refitted when the
+    // slack would pass mSlackLimit (a tenth of the body's mean edge length).
+    std::vector<double> mRef0, mRef1;
+    Vec3 mTreeOffset = Vec3::Zero();
+    double mTreeSlack = 0.0, mSlackLimit = 0.0;
     std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
     std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
     std::vector<contact::Box> mVertexBoxes; // per entry of mVertices, swept over the step
