@@ -315,6 +315,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     };
     const auto placedAt = [](double xi) { return xi * (1.0 + 1e-6) + 1e-9; };
     const contact::CcdOptions opt = optionsFor(thickness);
+    // The broad phase's reach: the CCD asks for at most ξ/2 (less for pinned corners), and the
+    // swept boxes hold each primitive throughout the step (its points are convex combinations
+    // of its corners at both ends), so a pair whose boxes are farther apart than ξ/2 stays
+    // farther apart than that: it is no hit (beyond the CCD's gap tolerance, 1 µm, for which
+    // the reach has room).
+    const double reach = opt.thickness + 2.0 * opt.gapTolerance;
     std::vector<int> cand;
     std::vector<uint8_t> moved(n, 0);
     // Cloth triangles hit by a body vertex that no movable corner can carry (all pinned, or the
@@ -372,7 +378,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             auto tb = tick();
             contact::Box q;
             addSwept(q, p0, p1);
-            q.inflate(thickness);
+            q.inflate(reach);
             double first = 2.0;
             int hitTri = -1;
             cand.clear();
@@ -440,7 +446,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             contact::Box q;
             addSwept(q, a0, a1);
             addSwept(q, b0, b1);
-            q.inflate(thickness);
+            q.inflate(reach);
             cand.clear();
             // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
             // of the triangles reached whose boxes do not are farther than the thickness from
@@ -534,7 +540,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             auto tb = tick();
             contact::Box q;
             for (int k = 0; k < 3; ++k) addSwept(q, c0[k], c1[k]);
-            q.inflate(thickness);
+            q.inflate(reach);
             cand.clear();
             mVertexBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end()); // body vertex order: a fixed tie-break
