@@ -400,6 +400,12 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         const std::vector<std::array<int, 3>>* tris = collisionTriangles();
         if (!c.moving || !tris) continue;
         for (const auto& tri : *tris) {
+            // No corner could take a contact (each constrained already, or near the surface
+            // itself): no query.
+            bool open = false;
+            for (int k = 0; k < 3; ++k)
+                open = open || (mConstraints.kind[tri[k]] == 0 && !nearSurface[tri[k]]);
+            if (!open) continue;
             Vec3 corners[3];
             for (int k = 0; k < 3; ++k) corners[k] = vec3At(mX.data(), tri[k]);
             Vec3 p, vel;
