@@ -343,6 +343,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     mStartBound.swap(mEndBound);
     mStartAt.swap(mEndAt);
     if (!carried) mStartBound.assign(slots, -1.0);
+    if (mNearTriangle.size() != slots) mNearTriangle.assign(slots, -1);
     mEndBound.assign(slots, -1.0);
     mEndAt.resize(3 * static_cast<Eigen::Index>(slots));
     mBoundTime = t + h; // the end pose's time, for the next substep
@@ -367,7 +368,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             if (mStartBound[slot] >= 0.0 &&
                 (x - vec3At(mStartAt.data(), slot)).norm() < mStartBound[slot] - reach)
                 continue; // farther than the band from the surface (1-Lipschitz distance)
-            const ContactPoint cp = queryCollider(pose, x);
+            const ContactPoint cp = queryCollider(pose, x, mNearTriangle[slot]);
+            mNearTriangle[slot] = cp.triangle;
             nearSurface[i] = cp.distance < reach;
             // Touching at the end of the last substep: within a band above the thickness (a
             // vertex that slid over a curved surface lifts off its tangent plane a little).
@@ -442,7 +444,9 @@ bool Body::endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, Contac
     const bool known = slot < mEndBound.size() && mEndBound[slot] >= 0.0;
     if (known && (x - vec3At(mEndAt.data(), slot)).norm() < mEndBound[slot] - beyond) return false;
     const ColliderPose& pose = mKin.colliders[k].end;
-    cp = queryCollider(pose, x);
+    const bool hinted = slot < mNearTriangle.size();
+    cp = queryCollider(pose, x, hinted ? mNearTriangle[slot] : -1);
+    if (hinted) mNearTriangle[slot] = cp.triangle;
     if (slot < mEndBound.size()) {
         // A moving mesh reports nothing (∞) beyond its search radius: that radius is the bound.
         mEndBound[slot] = std::isfinite(cp.distance) ? std::max(cp.distance, 0.0)

@@ -392,6 +392,9 @@ private:
     std::vector<double> mStartBound;
     VecX mStartAt;
     double mBoundTime = NAN;
+    // Per collider and vertex: the moving mesh's triangle its last query found closest (−1
+    // none), the hint of its next query (the answer does not depend on it).
+    std::vector<int> mNearTriangle;
     std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)
     std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
     std::vector<double> mFrictionInA;     // per vertex: the c now added to A (kg) ...

@@ -43,7 +43,7 @@ ColliderPose colliderPose(const Collider& c, double t) {
     return p;
 }
 
-ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x) {
+ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x, int hint) {
     ContactPoint cp;
     switch (pose.shape) {
     case ColliderShape::Plane:
@@ -75,7 +75,8 @@ ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x) {
         break;
     }
     case ColliderShape::Mesh:
-        if (pose.moving) pose.moving->closest(x, pose.atEnd, pose.searchRadius, cp); // inf when far
+        if (pose.moving)
+            pose.moving->closest(x, pose.atEnd, pose.searchRadius, cp, hint); // inf when far
         else if (pose.mesh) pose.mesh->query(x, cp.distance, cp.normal);
         else cp.distance = 1e30; // not loaded: never touches
         break;

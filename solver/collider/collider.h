@@ -39,6 +39,7 @@ struct ContactPoint {
     double distance = 0.0;
     Vec3 normal = Vec3::UnitY();
     Vec3 velocity = Vec3::Zero();
+    int triangle = -1; // a moving mesh's triangle the closest point is on (-1: none or other)
 };
 
 // Collider placement at a time, resolved once per query batch.
@@ -55,6 +56,8 @@ struct ColliderPose {
 ColliderPose colliderPose(const Collider& c, double t);
 
 // Signed distance, normal and surface velocity at point x.
-ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x);
+// `hint`: a moving mesh's triangle likely closest (an earlier answer's `triangle`), searched
+// first; the answer is the same with or without it.
+ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x, int hint = -1);
 
 } // namespace gale::solver

@@ -203,7 +203,8 @@ bool MovingMeshContact::treesStillHold() {
     return true;
 }
 
-bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const {
+bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out,
+                                int hint) const {
     out.distance = INFINITY;
     if (!mBuilt) return false;
     // The tree's boxes hold each triangle at t0 and at t1 in the frame moving with the body:
@@ -213,6 +214,19 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     int bestTri = -1;
     double bestW[3] = {0, 0, 0};
     const auto& tris = mMesh->triangles();
+    // The hint's distance bounds the walk from the start; the walk then keeps the lowest
+    // (distance, triangle) pair as without it (the hint met again changes nothing).
+    if (hint >= 0 && static_cast<size_t>(hint) < tris.size()) {
+        double w[3];
+        const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[hint][0]),
+                                                          corner(atEnd, tris[hint][1]),
+                                                          corner(atEnd, tris[hint][2]), w);
+        if (d2 < best) {
+            best = d2;
+            bestTri = hint;
+            std::copy(w, w + 3, bestW);
+        }
+    }
     // A nearest-point walk: a node or triangle whose box is farther than the best distance so
     // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
     // it is skipped; the closer child first. The lowest (distance, triangle) pair is kept, so the
@@ -243,6 +257,7 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     const double dist = d.norm();
     const Vec3 fn = faceNormal(atEnd, bestTri);
     out.distance = dist;
+    out.triangle = bestTri;
     out.normal = dist > 1e-12 ? Vec3(d / dist) : fn;
     out.velocity = v;
     return true;

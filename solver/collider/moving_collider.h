@@ -51,7 +51,9 @@ public:
     // searched within `radius`: unsigned distance (m; +inf beyond radius), the unit normal from
     // the surface towards x (the face normal when x is on it), and the surface velocity there
     // (the mean over the step, m/s). Returns false when nothing is within radius.
-    bool closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out) const;
+    // `hint`: a triangle likely closest (an earlier answer's out.triangle), whose distance bounds
+    // the search from the start; the answer is the same with or without it.
+    bool closest(const Vec3& x, bool atEnd, double radius, ContactPoint& out, int hint = -1) const;
 
     // The body vertex nearest to triangle (a, b, c) at the start of the prepared step, searched
     // within `radius` (m): its position p, the weights w of the triangle's point closest to it,

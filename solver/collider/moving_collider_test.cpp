@@ -574,3 +574,38 @@ TEST_CASE("moving mesh: a body moving as one keeps its trees, with the answers o
     CHECK(kept == 0);
     CHECK(refits == 5);
 }
+
+TEST_CASE("moving mesh: a closest-point query's hint changes nothing but its cost",
+          "[collider][moving]") {
+    const double h = 1.0 / 24.0, r = 0.2;
+    const Solid s = uvSphere(r, 24, 48);
+    MovingMeshContact m(flying(s, Vec3::Zero(), Vec3(2.0, 0.0, 0.0), 3, 24.0));
+    m.prepare(0.0, h);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    std::uniform_int_distribution<int> anyTri(0, static_cast<int>(s.tris.size()) - 1);
+    int found = 0;
+    for (int k = 0; k < 300; ++k) {
+        Vec3 dir(U(rng), U(rng), U(rng));
+        if (dir.norm() < 1e-3) continue;
+        dir.normalize();
+        const bool atEnd = k % 2;
+        // Some points at a vertex of the mesh (equal distances to several triangles: the tie).
+        const Vec3 centre = atEnd ? Vec3(2.0 * h, 0.0, 0.0) : Vec3::Zero();
+        const Vec3 x = k % 5 == 0
+                           ? Vec3(centre + 1.01 * vec3At(s.pos.data(), k % (s.pos.size() / 3)))
+                           : Vec3(centre + (r + 0.008 * U(rng)) * dir);
+        ContactPoint plain;
+        const bool hit = m.closest(x, atEnd, 0.01, plain);
+        found += hit;
+        for (int hint : {plain.triangle, anyTri(rng), -1, static_cast<int>(s.tris.size()) + 3}) {
+            ContactPoint cp;
+            REQUIRE(m.closest(x, atEnd, 0.01, cp, hint) == hit);
+            CHECK(cp.distance == plain.distance);
+            CHECK(cp.triangle == plain.triangle);
+            CHECK(cp.normal == plain.normal);
+            CHECK(cp.velocity == plain.velocity);
+        }
+    }
+    CHECK(found > 100);
+}
