@@ -123,7 +123,7 @@ TEST_CASE("aero: exact Jacobian matches central finite differences", "[aero]") {
 }
 
 TEST_CASE("aero: the orientation Jacobian dF/da matches finite differences", "[aero]") {
-    // Newton's full Jacobian needs how F turns with the triangle (AeroCoupling::position).
+    // Newton's full Jacobian needs how F turns with the triangle (AeroOrientation::position).
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     int checked = 0;

@@ -175,14 +175,16 @@ struct AeroCoupling {
     std::array<int, 3> v{-1, -1, -1};
     Mat3 damping = Mat3::Zero();
     Vec3 axis = Vec3::Zero();
-    // Newton's full Jacobian only (ForceInput::aeroPosition): the force's dependence on the
-    // triangle's orientation, −h²∂f/∂x δ at every corner = P((δ₁ − δ₀) × e₂ + e₁ × (δ₂ − δ₀)),
-    // P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner).
+};
+// Newton's full Jacobian only (ForceInput::aeroPosition), per cloth triangle beside its
+// AeroCoupling, allocated only for such assemblies: the force's dependence on the triangle's
+// orientation, −h²∂f/∂x δ at every corner = P((δ₁ − δ₀) × e₂ + e₁ × (δ₂ − δ₀)),
+// P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner); and what
+// `damping` leaves out of the exact (h/9)∂F/∂v (its whole skew part, ungated, and the clamped
+// negative part): Newton's iterations solve with the exact Jacobian, this in place of `axis`.
+struct AeroOrientation {
     Mat3 position = Mat3::Zero();
     Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero();
-    // ... and what `damping` leaves out of the exact (h/9)∂F/∂v (its whole skew part, ungated,
-    // and the clamped negative part): Newton's iterations solve with the exact Jacobian, this
-    // in place of `axis`.
     Mat3 velocityRest = Mat3::Zero();
 };
 
@@ -194,7 +196,7 @@ struct ForceInput {
     double t = 0.0, h = 0.0;
     double airDensity = 1.225;
     AeroJacobian aeroJacobian = AeroJacobian::Projected;
-    bool aeroPosition = false; // also the orientation part of ∂F/∂x (AeroCoupling::position)
+    bool aeroPosition = false; // also the orientation part of ∂F/∂x (AeroOrientation)
 };
 struct ForceOutput {
     VecX* f = nullptr;          // forces (N), accumulated
@@ -204,9 +206,10 @@ struct ForceOutput {
     int clamped = 0;
     // The aerodynamic linearisation per element when asked for (one slot each; empty: none).
     std::vector<AeroCoupling>* aero = nullptr;
-    // With ForceInput::aeroPosition: per triangle, the PSD part of the symmetrised orientation
-    // Jacobian (9×9, corners' blocks), also added to A so that the preconditioner sees it; the
-    // rest of AeroCoupling::position stays in the Krylov operator.
+    // With ForceInput::aeroPosition: per element, its AeroOrientation (the slots of `aero`), and
+    // the PSD part of the symmetrised orientation Jacobian (9×9, corners' blocks), also added
+    // to A so that the preconditioner sees it; the rest stays in the Krylov operator.
+    std::vector<AeroOrientation>* aeroOrientation = nullptr;
     std::vector<Mat9>* aeroPsd = nullptr;
     bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
 };
@@ -405,6 +408,7 @@ private:
     std::vector<AeroCoupling> mAero; // the aerodynamic linearisation of the last assembly
     bool mSkewed = false;            // ... with a skew part somewhere
     bool mAeroPosition = false;      // ... with the orientation part (Newton's iterations)
+    std::vector<AeroOrientation> mAeroOrientation; // Newton's full Jacobian only
     std::vector<Mat9> mAeroPsd;
     double mResidual2 = 0.0; // residualAt()'s 2-norm of the velocity residual (m/s)      // ... its
                              // PSD part, in A (ForceOutput::aeroPsd)

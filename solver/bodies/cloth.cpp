@@ -72,7 +72,7 @@ void addTriangleBlocks(BlockMatrix& A, const int slot[9], const MembraneFactors*
         }
     }
 }
-// The PSD part of the symmetrised orientation Jacobian of one triangle (AeroCoupling::position):
+// The PSD part of the symmetrised orientation Jacobian of one triangle (AeroOrientation):
 // blocks K_ab = P C_b for every corner a, with C₁ = −[e₂]×, C₂ = [e₁]×, C₀ = −C₁ − C₂; the
 // symmetric ½(K + Kᵀ) with its negative eigenvalues dropped (Teran et al. 2005's projection).
 Mat3 crossMatrix(const Vec3& e) { // [e]× x = e × x
@@ -81,7 +81,7 @@ Mat3 crossMatrix(const Vec3& e) { // [e]× x = e × x
     return m;
 }
 
-Mat9 orientationPsd(const AeroCoupling& c) {
+Mat9 orientationPsd(const AeroOrientation& c) {
     const Mat3 c1 = -crossMatrix(c.e2), c2 = crossMatrix(c.e1), c0 = -c1 - c2;
     const Mat3 pc[3] = {c.position * c0, c.position * c1, c.position * c2};
     Mat9 k;
@@ -192,6 +192,8 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     // aerodynamic force F/3 per corner. Its 9 matrix blocks (a, b) get, in one write each,
     //   cK·K_ab + (h/9)·D.
     if (out.aero) out.aero->assign(aeroMatrix ? nt : 0, AeroCoupling{}); // one slot per triangle
+    if (out.aeroOrientation)
+        out.aeroOrientation->assign(aeroMatrix && out.aero ? nt : 0, AeroOrientation{});
     if (out.aeroPsd) out.aeroPsd->assign(aeroMatrix && out.aero ? nt : 0, Mat9::Zero());
     std::atomic<bool> skewedAll{false}; // any triangle with a skew part
     // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
@@ -233,18 +235,19 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                     if (out.aero) {
                         AeroCoupling& c = (*out.aero)[e];
                         c = {{tri[0], tri[1], tri[2]}, hD9, (h / 9.0) * r.skewAxis};
-                        if (in.aeroPosition) {
-                            c.position = (-h * h / 6.0) * aeroTriangleAreaJacobian(
+                        if (in.aeroPosition && out.aeroOrientation) {
+                            AeroOrientation& o = (*out.aeroOrientation)[e];
+                            o.position = (-h * h / 6.0) * aeroTriangleAreaJacobian(
                                                               wind - u, areaNormal, in.airDensity,
                                                               cl, cd, mMat.aeroModel);
-                            c.e1 = p[1] - p[0];
-                            c.e2 = p[2] - p[0];
-                            c.velocityRest = (h / 9.0) * aeroTriangleExactJacobian(
+                            o.e1 = p[1] - p[0];
+                            o.e2 = p[2] - p[0];
+                            o.velocityRest = (h / 9.0) * aeroTriangleExactJacobian(
                                                              wind - u, areaNormal, in.airDensity,
                                                              cl, cd, mMat.aeroModel) -
                                              hD9;
                             if (out.aeroPsd && A) {
-                                (*out.aeroPsd)[e] = orientationPsd(c);
+                                (*out.aeroPsd)[e] = orientationPsd(o);
                                 const Mat9& s9 = (*out.aeroPsd)[e];
                                 for (int a = 0; a < 3; ++a)
                                     for (int b = 0; b < 3; ++b)
