@@ -128,39 +128,52 @@ void MovingMeshContact::prepare(double t0, double t1) {
         mStats.refitSeconds += seconds(start);
         return;
     }
-    // (Re)fitted in this step's frame: the corners kept for treesStillHold().
+    // (Re)fitted in this step's frame: the corners kept for treesStillHold(), and each
+    // vertex's box over the step in that frame (its corners at both ends). A primitive's box is
+    // the union of its vertices' (the box of all its corners at both ends). Not inflated: every
+    // query inflates its own box by its reach (a thickness, a search radius), which is enough
+    // (two boxes within the reach of each other are what a pair within it needs).
     mTreeOffset.setZero();
     mTreeSlack = 0.0;
     mRef0.resize(mP0.size());
     mRef1.resize(mP1.size());
+    mCornerBoxes.resize(mP0.size() / 3);
     for (int v : mVertices) {
-        vec3At(mRef0.data(), v) = corner(false, v);
-        vec3At(mRef1.data(), v) = corner(true, v) - mShift;
+        const Vec3 a = corner(false, v), b = corner(true, v) - mShift;
+        vec3At(mRef0.data(), v) = a;
+        vec3At(mRef1.data(), v) = b;
+        contact::Box& box = mCornerBoxes[v];
+        box.lo = a.cwiseMin(b);
+        box.hi = a.cwiseMax(b);
     }
     const auto& tris = mMesh->triangles();
-    // A primitive's box over the step in that frame: its corners at both ends. Not inflated:
-    // every query inflates its own box by its reach (a thickness, a search radius), which is
-    // enough (two boxes within the reach of each other are what a pair within it needs).
-    const auto sweptBox = [&](const int* v, int count) {
-        contact::Box b;
-        for (int c = 0; c < count; ++c) addSwept(b, corner(false, v[c]), corner(true, v[c]));
+    const auto triangleBox = [&](int k) {
+        contact::Box b = mCornerBoxes[tris[k][0]];
+        b.add(mCornerBoxes[tris[k][1]]);
+        b.add(mCornerBoxes[tris[k][2]]);
         return b;
     };
-    mBoxes.resize(tris.size());
-    for (size_t k = 0; k < tris.size(); ++k) mBoxes[k] = sweptBox(tris[k].data(), 3);
     // The body's edges get their own tree: an edge–edge query then meets only the edges whose
     // swept boxes reach the cloth edge's, not every edge of every triangle it reaches (each
     // three times, to be sorted and made unique).
-    mEdgeBoxes.resize(mEdges.size());
-    for (size_t e = 0; e < mEdges.size(); ++e) mEdgeBoxes[e] = sweptBox(mEdges[e].data(), 2);
+    const auto edgeBox = [&](int e) {
+        contact::Box b = mCornerBoxes[mEdges[e][0]];
+        b.add(mCornerBoxes[mEdges[e][1]]);
+        return b;
+    };
     // And the body's vertices, for the body vertex–cloth triangle pair (queried with each cloth
     // triangle's swept box).
-    mVertexBoxes.resize(mVertices.size());
-    for (size_t v = 0; v < mVertices.size(); ++v) mVertexBoxes[v] = sweptBox(&mVertices[v], 1);
+    const auto vertexBox = [&](int k) { return mCornerBoxes[mVertices[k]]; };
     if (!mBuilt) {
-        mBvh.build(mBoxes);
-        mEdgeBvh.build(mEdgeBoxes);
-        mVertexBvh.build(mVertexBoxes);
+        std::vector<contact::Box> boxes(tris.size());
+        for (size_t k = 0; k < tris.size(); ++k) boxes[k] = triangleBox(static_cast<int>(k));
+        mBvh.build(boxes);
+        boxes.resize(mEdges.size());
+        for (size_t e = 0; e < mEdges.size(); ++e) boxes[e] = edgeBox(static_cast<int>(e));
+        mEdgeBvh.build(boxes);
+        boxes.resize(mVertices.size());
+        for (size_t k = 0; k < mVertices.size(); ++k) boxes[k] = vertexBox(static_cast<int>(k));
+        mVertexBvh.build(boxes);
         mBuilt = true;
         // The slack limit: a tenth of the body's mean edge length (every query reaches that
         // much farther while the trees are kept).
@@ -171,9 +184,9 @@ void MovingMeshContact::prepare(double t0, double t1) {
         mStats.buildSeconds += seconds(start);
         return;
     }
-    mBvh.refit(mBoxes);
-    mEdgeBvh.refit(mEdgeBoxes);
-    mVertexBvh.refit(mVertexBoxes);
+    mBvh.refitBy(triangleBox);
+    mEdgeBvh.refitBy(edgeBox);
+    mVertexBvh.refitBy(vertexBox);
     ++mStats.refits;
     mStats.refitSeconds += seconds(start);
 }

@@ -138,9 +138,7 @@ private:
     std::vector<double> mRef0, mRef1;
     Vec3 mTreeOffset = Vec3::Zero();
     double mTreeSlack = 0.0, mSlackLimit = 0.0;
-    std::vector<contact::Box> mBoxes;       // per triangle, swept over the step
-    std::vector<contact::Box> mEdgeBoxes;   // per body edge, swept over the step
-    std::vector<contact::Box> mVertexBoxes; // per entry of mVertices, swept over the step
+    std::vector<contact::Box> mCornerBoxes; // per mesh vertex, swept over the step (refit scratch)
     contact::Bvh mBvh, mEdgeBvh, mVertexBvh;
     bool mBuilt = false;
     bool mDetailedTiming = false;

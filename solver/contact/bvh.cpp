@@ -61,6 +61,10 @@ int Bvh::buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>&
 
 void Bvh::refit(const std::vector<Box>& boxes) {
     for (size_t i = 0; i < mOrder.size(); ++i) mLeafBoxes[i] = boxes[mOrder[i]];
+    refitNodes();
+}
+
+void Bvh::refitNodes() {
     for (size_t k = mNodes.size(); k-- > 0;) {
         Node& n = mNodes[k];
         Box b;

@@ -47,6 +47,12 @@ public:
     void build(const std::vector<Box>& boxes);
     // New boxes for the same primitives (same count): every node's box recomputed bottom-up.
     void refit(const std::vector<Box>& boxes);
+    // The same with primitive p's box boxOf(p), written straight in leaf order.
+    template <class BoxOf>
+    void refitBy(BoxOf&& boxOf) {
+        for (std::size_t i = 0; i < mOrder.size(); ++i) mLeafBoxes[i] = boxOf(mOrder[i]);
+        refitNodes();
+    }
     // Calls fn(primitive) for every primitive whose box overlaps `q`; returns the nodes visited.
     std::size_t query(const Box& q, const std::function<void(int)>& fn) const;
     // Calls fn(a, b) for every primitive a of this tree and b of `other` whose boxes overlap, by
@@ -155,6 +161,7 @@ private:
     };
     int buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>& centres, int begin,
                    int end);
+    void refitNodes(); // every node's box from mLeafBoxes, bottom-up
     // One step of the descent from node pair t: −1 when the nodes' boxes do not overlap, 0 for a
     // pair of leaves (or a leaf with itself), else the number of child pairs written to `kids`
     // in the order they are pushed on the walk's stack (so popped in reverse).
