@@ -75,6 +75,11 @@ struct Run {
     int substeps = 0, laterSubsteps = 0; // all, and those after the first frame
 };
 
+// Seconds a substep after the first frame.
+double stepSeconds(const Run& r) {
+    return r.laterSeconds / std::max(1, r.laterSubsteps);
+}
+
 // A 0.6 m sheet of res² vertices hit by the ball (radius 0.2 m) at 5 m/s; `withBody` false:
 // the same sheet without the collider (the baseline).
 Run ballRun(const Sphere& ball, int res, int substeps, double thickness, int frames, bool withBody,
@@ -210,9 +215,6 @@ int main(int argc, char** argv) {
             rebuild = std::min(rebuild, seconds([&] { fresh.prepare(0.0, 1.0 / 24.0); }));
         }
         const double steps = static_cast<double>(std::max(1, with.substeps));
-        const auto stepSeconds = [](const Run& r) {
-            return r.laterSeconds / std::max(1, r.laterSubsteps);
-        };
         std::printf("| %zu | %.3f | %.3f | %.2f | %.3f | %.3f | %.0f | %.2f | %.2f | %.2fx | %.3f "
                     "| %.1f | %.1f / %.1f |\n",
                     ball.tris.size(), 1e3 * refit, 1e3 * rebuild, refit / rebuild,
@@ -232,9 +234,6 @@ int main(int argc, char** argv) {
         const Sphere ball = sphere(0.2, tris);
         const Run with = ballRun(ball, 48, 1, 0.005, frames, true, false, 2.0 * M_PI);
         const Run without = ballRun(ball, 48, 1, 0.005, frames, false);
-        const auto stepSeconds = [](const Run& r) {
-            return r.laterSeconds / std::max(1, r.laterSubsteps);
-        };
         const double steps = static_cast<double>(std::max(1, with.substeps));
         std::printf("| %zu | %.3f | %.0f | %.2f | %.2f | %.2fx |\n", ball.tris.size(),
                     1e3 * with.stats.refitSeconds / std::max<long long>(1, with.stats.refits),

@@ -246,7 +246,6 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     out.A = matrix ? &mA : nullptr;
     out.aero = matrix ? &mAero : nullptr;
     out.aeroOrientation = matrix && in.aeroPosition ? &mAeroOrientation : nullptr;
-    out.aeroPsd = matrix && in.aeroPosition ? &mAeroPsd : nullptr;
     out.skewed = false;
     if (matrix) mAero.clear();
     addForces(in, out);
@@ -705,16 +704,14 @@ void Body::skewProduct(const VecX& x, VecX& y) const {
         if (mAeroPosition && c.v[2] >= 0) {
             // Newton's full Jacobian: all of ∂F/∂v beyond the damping in A, and the orientation
             // part less its PSD part (which is in A too).
-            const size_t e = static_cast<size_t>(&c - mAero.data());
-            const AeroOrientation& o = mAeroOrientation[e];
+            const AeroOrientation& o = mAeroOrientation[static_cast<size_t>(&c - mAero.data())];
             const Vec3 d0 = x.segment<3>(3 * c.v[0]);
             Vec3 w = o.velocityRest * cornerSum(c, x);
             w += o.position * ((x.segment<3>(3 * c.v[1]) - d0).cross(o.e2) +
                                o.e1.cross(x.segment<3>(3 * c.v[2]) - d0));
-            const Mat9& psd = mAeroPsd[e];
             Eigen::Matrix<double, 9, 1> xt;
             for (int k = 0; k < 3; ++k) xt.segment<3>(3 * k) = x.segment<3>(3 * c.v[k]);
-            const Eigen::Matrix<double, 9, 1> px = psd * xt;
+            const Eigen::Matrix<double, 9, 1> px = o.psd * xt;
             for (int k = 0; k < 3; ++k) y.segment<3>(3 * c.v[k]) += w - px.segment<3>(3 * k);
             continue;
         }

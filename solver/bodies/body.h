@@ -182,10 +182,13 @@ struct AeroCoupling {
 // P = −(h²/6) ∂F/∂a, e₁ = x₁ − x₀, e₂ = x₂ − x₀ (a = ½ e₁ × e₂, f = F/3 per corner); and what
 // `damping` leaves out of the exact (h/9)∂F/∂v (its whole skew part, ungated, and the clamped
 // negative part): Newton's iterations solve with the exact Jacobian, this in place of `axis`.
+// `psd`: the PSD part of the symmetrised orientation Jacobian (9×9, corners' blocks), also
+// added to A so that the preconditioner sees it; the rest stays in the Krylov operator.
 struct AeroOrientation {
     Mat3 position = Mat3::Zero();
     Vec3 e1 = Vec3::Zero(), e2 = Vec3::Zero();
     Mat3 velocityRest = Mat3::Zero();
+    Mat9 psd = Mat9::Zero();
 };
 
 // What a body's force routine reads and writes.
@@ -206,11 +209,8 @@ struct ForceOutput {
     int clamped = 0;
     // The aerodynamic linearisation per element when asked for (one slot each; empty: none).
     std::vector<AeroCoupling>* aero = nullptr;
-    // With ForceInput::aeroPosition: per element, its AeroOrientation (the slots of `aero`), and
-    // the PSD part of the symmetrised orientation Jacobian (9×9, corners' blocks), also added
-    // to A so that the preconditioner sees it; the rest stays in the Krylov operator.
+    // With ForceInput::aeroPosition: per element, its AeroOrientation (the slots of `aero`).
     std::vector<AeroOrientation>* aeroOrientation = nullptr;
-    std::vector<Mat9>* aeroPsd = nullptr;
     bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
 };
 
@@ -409,9 +409,7 @@ private:
     bool mSkewed = false;            // ... with a skew part somewhere
     bool mAeroPosition = false;      // ... with the orientation part (Newton's iterations)
     std::vector<AeroOrientation> mAeroOrientation; // Newton's full Jacobian only
-    std::vector<Mat9> mAeroPsd;
-    double mResidual2 = 0.0; // residualAt()'s 2-norm of the velocity residual (m/s)      // ... its
-                             // PSD part, in A (ForceOutput::aeroPsd)
+    double mResidual2 = 0.0;     // residualAt()'s 2-norm of the velocity residual (m/s)
     double mStretchBefore = 0.0; // the largest edge stretch at the substep's start
     double mRecoverySpeed = 0.0, mRecoveryStretch = 3.0; // recover()'s limits, set by substep()
     Constraints mZeroZ;         // mConstraints with z = 0 (solveLinear's preconditioner)

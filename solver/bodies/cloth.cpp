@@ -194,7 +194,6 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
     if (out.aero) out.aero->assign(aeroMatrix ? nt : 0, AeroCoupling{}); // one slot per triangle
     if (out.aeroOrientation)
         out.aeroOrientation->assign(aeroMatrix && out.aero ? nt : 0, AeroOrientation{});
-    if (out.aeroPsd) out.aeroPsd->assign(aeroMatrix && out.aero ? nt : 0, Mat9::Zero());
     std::atomic<bool> skewedAll{false}; // any triangle with a skew part
     // Triangles in blocks, colour by colour (mTriBlocks), the blocks of a colour in parallel:
     // they share no vertex, so each vertex and slot receives its terms in the same order on any
@@ -246,13 +245,12 @@ void Cloth::addForces(const ForceInput& in, ForceOutput& out) {
                                                              wind - u, areaNormal, in.airDensity,
                                                              cl, cd, mMat.aeroModel) -
                                              hD9;
-                            if (out.aeroPsd && A) {
-                                (*out.aeroPsd)[e] = orientationPsd(o);
-                                const Mat9& s9 = (*out.aeroPsd)[e];
+                            if (A) {
+                                o.psd = orientationPsd(o);
                                 for (int a = 0; a < 3; ++a)
                                     for (int b = 0; b < 3; ++b)
                                         A->addBlock(mTriSlots[e][3 * a + b],
-                                                    s9.block<3, 3>(3 * a, 3 * b));
+                                                    o.psd.block<3, 3>(3 * a, 3 * b));
                             }
                         }
                     }

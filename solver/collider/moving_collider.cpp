@@ -227,37 +227,27 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
     int bestTri = -1;
     double bestW[3] = {0, 0, 0};
     const auto& tris = mMesh->triangles();
-    // The hint's distance bounds the walk from the start; the walk then keeps the lowest
-    // (distance, triangle) pair as without it (the hint met again changes nothing).
-    if (hint >= 0 && static_cast<size_t>(hint) < tris.size()) {
+    // Triangle k against the best so far: the lowest (distance, triangle) pair is kept, so the
+    // result does not depend on the order of the visits.
+    const auto consider = [&](int k) {
         double w[3];
-        const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[hint][0]),
-                                                          corner(atEnd, tris[hint][1]),
-                                                          corner(atEnd, tris[hint][2]), w);
-        if (d2 < best) {
+        const double d2 = contact::pointTriangleDistance2(
+            x, corner(atEnd, tris[k][0]), corner(atEnd, tris[k][1]), corner(atEnd, tris[k][2]), w);
+        if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
             best = d2;
-            bestTri = hint;
+            bestTri = k;
             std::copy(w, w + 3, bestW);
         }
-    }
+    };
+    // The hint's distance bounds the walk from the start (met again in the walk, it changes
+    // nothing).
+    if (hint >= 0 && static_cast<size_t>(hint) < tris.size()) consider(hint);
     // A nearest-point walk: a node or triangle whose box is farther than the best distance so
     // far cannot hold a closer point (the boxes hold the triangles at both ends of the step), so
-    // it is skipped; the closer child first. The lowest (distance, triangle) pair is kept, so the
-    // result does not depend on the order of the visits.
-    mBvh.nearestFirst(
-        [&](const contact::Box& b) { return treeDistance2(b, xq); },
-        [&] { return withSlack(best); },
-        [&](int k, const contact::Box&) {
-            double w[3];
-            const double d2 = contact::pointTriangleDistance2(x, corner(atEnd, tris[k][0]),
-                                                              corner(atEnd, tris[k][1]),
-                                                              corner(atEnd, tris[k][2]), w);
-            if (d2 < best || (d2 == best && bestTri >= 0 && k < bestTri)) {
-                best = d2;
-                bestTri = k;
-                std::copy(w, w + 3, bestW);
-            }
-        });
+    // it is skipped; the closer child first.
+    mBvh.nearestFirst([&](const contact::Box& b) { return treeDistance2(b, xq); },
+                      [&] { return withSlack(best); },
+                      [&](int k, const contact::Box&) { consider(k); });
     if (bestTri < 0) return false;
     const auto& t = tris[bestTri];
     Vec3 p = Vec3::Zero(), v = Vec3::Zero();
@@ -477,9 +467,9 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             q.inflate(reach);
             cand.clear();
             // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
-            // of the triangles reached whose boxes do not are farther than the thickness from
-            // the cloth edge throughout the step (the query's box is inflated by it, and CCD
-            // asks for half of it), so they cannot be hit.
+            // of the triangles reached whose boxes do not are farther than the CCD's ξ/2 from
+            // the cloth edge throughout the step (the query's box is inflated by `reach`), so
+            // they cannot be hit.
             mEdgeBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
             std::sort(cand.begin(), cand.end());
             mStats.broadSeconds += since(tb);

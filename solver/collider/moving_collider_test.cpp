@@ -49,17 +49,28 @@ Solid box(double hx, double hy, double hz) {
     return s;
 }
 
-// Frames 0..frames of the solid translated from `start` at `velocity` (m/s), at fps.
-std::shared_ptr<const MeshSequence> flying(const Solid& s, const Vec3& start, const Vec3& velocity,
-                                           int frames, double fps) {
+// Frames 0..frames of the solid, each vertex at R_f p + c_f.
+std::shared_ptr<const MeshSequence> posed(const Solid& s, int frames, double fps,
+                                          const std::function<Mat3(int)>& rotation,
+                                          const std::function<Vec3(int)>& centre) {
     std::vector<std::vector<double>> pos;
     for (int f = 0; f <= frames; ++f) {
-        std::vector<double> p = s.pos;
-        const Vec3 c = start + velocity * (f / fps);
-        for (size_t i = 0; i < p.size(); ++i) p[i] += c[i % 3];
+        std::vector<double> p(s.pos.size());
+        const Mat3 R = rotation(f);
+        const Vec3 c = centre(f);
+        for (size_t v = 0; v < p.size() / 3; ++v)
+            vec3At(p.data(), v) = R * vec3At(s.pos.data(), v) + c;
         pos.push_back(std::move(p));
     }
     return std::make_shared<MeshSequence>(s.tris, pos, 0, fps);
+}
+
+// Frames 0..frames of the solid translated from `start` at `velocity` (m/s), at fps.
+std::shared_ptr<const MeshSequence> flying(const Solid& s, const Vec3& start, const Vec3& velocity,
+                                           int frames, double fps) {
+    return posed(
+        s, frames, fps, [](int) { return Mat3(Mat3::Identity()); },
+        [&](int f) { return Vec3(start + velocity * (f / fps)); });
 }
 
 // The largest signed plane distance of x over the faces (< 0: inside a convex solid).
@@ -466,22 +477,6 @@ TEST_CASE("moving mesh: queries in the body's moving frame", "[collider][moving]
 }
 
 namespace {
-
-// Frames 0..frames of the solid, each vertex at R_f p + c_f.
-std::shared_ptr<const MeshSequence> posed(const Solid& s, int frames, double fps,
-                                          const std::function<Mat3(int)>& rotation,
-                                          const std::function<Vec3(int)>& centre) {
-    std::vector<std::vector<double>> pos;
-    for (int f = 0; f <= frames; ++f) {
-        std::vector<double> p(s.pos.size());
-        const Mat3 R = rotation(f);
-        const Vec3 c = centre(f);
-        for (size_t v = 0; v < p.size() / 3; ++v)
-            vec3At(p.data(), v) = R * vec3At(s.pos.data(), v) + c;
-        pos.push_back(std::move(p));
-    }
-    return std::make_shared<MeshSequence>(s.tris, pos, 0, fps);
-}
 
 // Step after step, the same queries of `kept` (prepared step after step, so that it may keep
 // its trees) and of a contact built afresh at each step give the same answers, exactly.
