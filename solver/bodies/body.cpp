@@ -585,8 +585,17 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
             const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
             ContactPoint cp;
-            if (!endPoseQuery(k, i, x1, thick - kContactSlop, cp)) continue;
-            if (!(cp.distance < thick - kContactSlop)) continue;
+            bool found = endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
+                         cp.distance < thick - kContactSlop;
+            // An open surface (Collider::open: a cloth the hair meets) the step's path went
+            // through, ending beyond it (its unsigned distance there can exceed ξ: the query
+            // above misses it): the continuous pass's vertex test, the face it met as a plane at
+            // the step's end (moving_collider.h, sweptContact), is the contact, so that the
+            // solve, not the pass after it, stops the vertex on its side.
+            if (!found && c.moving && c.open)
+                found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
+                        cp.distance < 0.0;
+            if (!found) continue;
             if (!((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
             setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, c.friction > 0.0);
             mContactMu[i] = c.friction;

@@ -283,6 +283,9 @@ public:
     double edgeStretchOf(const VecX& x, size_t e) const;
     // Every vertex bound to a body's surface (hard and soft attachments) and its bound point at t.
     void attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const;
+    // The colliders will not be where the last substep left them at its end (a collider made
+    // anew for the next substep): the distance bounds carried from it are dropped.
+    void forgetColliderBounds() { mBoundTime = NAN; }
     // Whether pin k (pinnedVertices()[k]) follows an attachment (a body's surface), not a pin.
     bool pinIsAttachment(size_t k) const { return k < mPinBinding.size() && mPinBinding[k]; }
 

@@ -96,6 +96,11 @@ MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
         if (used[v]) mVertices.push_back(static_cast<int>(v));
 }
 
+void MovingMeshContact::setMesh(std::shared_ptr<const MeshSequence> mesh) {
+    mMesh = std::move(mesh);
+    mT0 = mT1 = NAN; // no interval cached: the next prepare() reads both ends
+}
+
 Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
     return vec3At((atEnd ? mP1 : mP0).data(), v);
 }
@@ -299,6 +304,81 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     return true;
 }
 
+size_t MovingMeshContact::vertexHit(const Vec3& p0, const Vec3& p1, const contact::CcdOptions& opt,
+                                    double reach, std::vector<int>& cand,
+                                    MovingMeshContact::VertexHit& hit) const {
+    hit = VertexHit{};
+    contact::Box q;
+    addSwept(q, p0, p1);
+    q.inflate(reach);
+    cand.clear();
+    mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
+    std::sort(cand.begin(), cand.end()); // triangle order: a fixed tie-break
+    const auto& tris = mMesh->triangles();
+    double first = 2.0;
+    for (int k : cand) {
+        const auto& t = tris[k];
+        double toi;
+        const Vec3 s0[4] = {p0, corner(false, t[0]), corner(false, t[1]), corner(false, t[2])};
+        const Vec3 s1[4] = {p1, corner(true, t[0]), corner(true, t[1]), corner(true, t[2])};
+        const Vec3 lo = s0[1].cwiseMin(s0[2]).cwiseMin(s0[3]),
+                   hi = s0[1].cwiseMax(s0[2]).cwiseMax(s0[3]);
+        if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
+        if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
+                                       corner(false, t[1]), corner(true, t[1]), corner(false, t[2]),
+                                       corner(true, t[2]), opt, toi) &&
+            toi < first) {
+            first = toi;
+            hit.triangle = k;
+        }
+    }
+    if (hit.triangle < 0) return cand.size();
+    const auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
+    const auto& t = tris[hit.triangle];
+    const Vec3 a = lerp(corner(false, t[0]), corner(true, t[0]), first),
+               b = lerp(corner(false, t[1]), corner(true, t[1]), first),
+               c = lerp(corner(false, t[2]), corner(true, t[2]), first);
+    const Vec3 pt = lerp(p0, p1, first);
+    double* w = hit.w;
+    contact::pointTriangleDistance2(pt, a, b, c, w);
+    const Vec3 q0 = w[0] * a + w[1] * b + w[2] * c;
+    Vec3 nt = pt - q0;
+    const Vec3 fnt = (b - a).cross(c - a);
+    if (!(nt.norm() > 1e-12)) nt = fnt.dot(p0 - q0) >= 0.0 ? fnt : Vec3(-fnt);
+    const Vec3 fn1 = faceNormal(true, hit.triangle);
+    // The side the vertex is on, carried to the end of the step with the face.
+    hit.normal = fn1.dot(nt) >= 0.0 ? fn1 : Vec3(-fn1);
+    // Off a face's interior use the direction to the closest point's feature instead (edges and
+    // corners: the normal of the face does not separate there).
+    const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
+    if (!interior) hit.normal = nt.normalized();
+    hit.point = w[0] * corner(true, t[0]) + w[1] * corner(true, t[1]) + w[2] * corner(true, t[2]);
+    hit.time = first;
+    return cand.size();
+}
+
+bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thickness,
+                                     ContactPoint& out) const {
+    if (!mBuilt || !p0.allFinite() || !p1.allFinite()) return false;
+    contact::CcdOptions opt;
+    opt.thickness = 0.5 * thickness; // as the continuous pass (sweep)
+    opt.shrinkWithinThickness = true;
+    std::vector<int> cand;
+    VertexHit hit;
+    vertexHit(p0, p1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
+    if (hit.triangle < 0) return false;
+    const auto& t = mMesh->triangles()[hit.triangle];
+    out.distance = (p1 - hit.point).dot(hit.normal);
+    out.normal = hit.normal;
+    out.velocity = Vec3::Zero();
+    const double h = mT1 - mT0;
+    if (h > 0.0)
+        for (int k = 0; k < 3; ++k)
+            out.velocity += hit.w[k] * (corner(true, t[k]) - corner(false, t[k])) / h;
+    out.triangle = hit.triangle;
+    return true;
+}
+
 int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
                              const std::vector<std::array<int, 2>>& edges,
@@ -394,61 +474,28 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
             if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
             auto tb = tick();
-            contact::Box q;
-            addSwept(q, p0, p1);
-            q.inflate(reach);
-            double first = 2.0;
-            int hitTri = -1;
-            cand.clear();
-            mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
-            std::sort(cand.begin(), cand.end()); // triangle order: a fixed tie-break
-            mStats.broadSeconds += since(tb);
-            mStats.candidates += static_cast<long long>(cand.size());
-            auto tn = tick();
-            for (int k : cand) {
-                const auto& t = tris[k];
-                double toi;
-                const Vec3 s0[4] = {p0, corner(false, t[0]), corner(false, t[1]),
-                                    corner(false, t[2])};
-                const Vec3 s1[4] = {p1, corner(true, t[0]), corner(true, t[1]), corner(true, t[2])};
-                const Vec3 lo = s0[1].cwiseMin(s0[2]).cwiseMin(s0[3]),
-                           hi = s0[1].cwiseMax(s0[2]).cwiseMax(s0[3]);
-                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
-                if (contact::vertexTriangleCcd(p0, p1, corner(false, t[0]), corner(true, t[0]),
-                                               corner(false, t[1]), corner(true, t[1]),
-                                               corner(false, t[2]), corner(true, t[2]), opt, toi) &&
-                    toi < first) {
-                    first = toi;
-                    hitTri = k;
-                }
-            }
-            if (hitTri >= 0) {
-                const auto& t = tris[hitTri];
-                double w[3];
-                const Vec3 a = lerp(corner(false, t[0]), corner(true, t[0]), first),
-                           b = lerp(corner(false, t[1]), corner(true, t[1]), first),
-                           c = lerp(corner(false, t[2]), corner(true, t[2]), first);
-                const Vec3 pt = lerp(p0, p1, first);
-                contact::pointTriangleDistance2(pt, a, b, c, w);
-                const Vec3 q0 = w[0] * a + w[1] * b + w[2] * c;
-                Vec3 nt = pt - q0;
-                const Vec3 fnt = (b - a).cross(c - a);
-                if (!(nt.norm() > 1e-12)) nt = fnt.dot(p0 - q0) >= 0.0 ? fnt : Vec3(-fnt);
-                const Vec3 fn1 = faceNormal(true, hitTri);
-                // The side the vertex is on, carried to the end of the step with the face.
-                Vec3 n1 = fn1.dot(nt) >= 0.0 ? fn1 : Vec3(-fn1);
-                // Off a face's interior use the direction to the closest point's feature instead
-                // (edges and corners: the normal of the face does not separate there).
-                const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
-                if (!interior) n1 = nt.normalized();
-                Vec3 q1 = Vec3::Zero();
-                for (int k = 0; k < 3; ++k) q1 += w[k] * corner(true, t[k]);
-                vec3At(x1.data(), i) = q1 + placedAt(thickness) * n1;
-                respond(static_cast<int>(i), surfaceVelocity(hitTri, w), n1);
-                ++hits;
-                ++mStats.vertexHits;
-            }
-            mStats.narrowSeconds += since(tn);
+            VertexHit hit;
+            const size_t candidates = vertexHit(p0, p1, opt, reach, cand, hit);
+            mStats.narrowSeconds += since(tb); // broad and narrow phase together here
+            mStats.candidates += static_cast<long long>(candidates);
+            if (hit.triangle < 0) continue;
+            // Placed ξ off the face's plane through the point it met (as that point is at the
+            // step's end), on the side it came from, with its tangential displacement from that
+            // point cut by Coulomb's bound on the position: by at most μ × the normal correction
+            // δ (μ = 0: lifted straight out, its own sliding kept — a path that only dipped
+            // within ξ/2 of a deforming surface is not dragged back along it; μ large: held at
+            // the point it met, which moves on with the surface).
+            Eigen::Map<Vec3> x1i(x1.data() + 3 * i);
+            const Vec3 off = x1i - hit.point;
+            const double above = off.dot(hit.normal);
+            const Vec3 slide = off - above * hit.normal;
+            const double delta = std::max(0.0, placedAt(thickness) - above);
+            const double length = slide.norm();
+            const double keep = length > 0.0 ? std::max(0.0, 1.0 - friction * delta / length) : 0.0;
+            x1i = hit.point + std::max(above, placedAt(thickness)) * hit.normal + keep * slide;
+            respond(static_cast<int>(i), surfaceVelocity(hit.triangle, hit.w), hit.normal);
+            ++hits;
+            ++mStats.vertexHits;
         }
         // Cloth edges against body edges.
         for (const auto& e : edges) {

@@ -8,8 +8,9 @@
 #pragma once
 
 #include "solver/contact/bvh.h"
-#include "solver/mesh/mesh_sequence.h"
+#include "solver/contact/ccd.h"
 #include "solver/linalg/types.h"
+#include "solver/mesh/mesh_sequence.h"
 
 #include <array>
 #include <cmath>
@@ -40,6 +41,9 @@ public:
     explicit MovingMeshContact(std::shared_ptr<const MeshSequence> mesh);
 
     const MeshSequence& mesh() const { return *mMesh; }
+    // Another motion of the same triangles (the vertex count and triangles must match): the
+    // next prepare() reads its positions anew and refits the trees (or keeps them, as ever).
+    void setMesh(std::shared_ptr<const MeshSequence> mesh);
     // The step [t0, t1]: corners at both ends, the swept boxes of the triangles, edges and
     // vertices, the trees refitted (built on the first call). Cached: the same interval twice
     // is free.
@@ -65,16 +69,24 @@ public:
     // The continuous pass over the prepared step for one body: vertex i moves from x0 to x1
     // (where `movable[i]`), edges and triangles as given (`triangles` empty for hair). Where a
     // vertex or an edge would come within `thickness` of the moving surface, it is placed at
-    // `thickness` off the surface point it met, as that point is at the step's end, its approach
-    // speed removed (relative to the surface), and Coulomb friction μ applied to the tangential
-    // speed; where a body vertex would come within `thickness` of a cloth triangle, the
-    // triangle's movable corners are moved so that it ends `thickness` off the body vertex, on
-    // the side it started, with the same velocity response at the point it met. Repeated (at
-    // most `passes` times) until no motion meets the surface. Returns the vertices moved.
+    // `thickness` off the surface it met, as that is at the step's end (a vertex: off the face's
+    // plane through the point it met, its slide from that point cut by μ × the normal
+    // correction), its approach speed removed (relative to the surface), and Coulomb friction μ
+    // applied to the tangential speed; where a body vertex would come within `thickness` of a cloth
+    // triangle, the triangle's movable corners are moved so that it ends `thickness` off the body
+    // vertex, on the side it started, with the same velocity response at the point it met. Repeated
+    // (at most `passes` times) until no motion meets the surface. Returns the vertices moved.
     int sweep(const VecX& x0, VecX& x1, VecX& v1, const std::vector<uint8_t>& movable,
               const std::vector<std::array<int, 2>>& edges,
               const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
               double h, int passes = 4);
+
+    // The vertex test of the continuous pass for a path p0 → p1 over the prepared step, as a
+    // contact plane for the solve: when the path comes within ξ/2 of the surface (a crossing
+    // too), the face it met first, at the step's end — `out.normal` its normal on the side the
+    // vertex came from, `out.distance` the signed distance of p1 above that plane (negative:
+    // beyond it), the surface velocity there. False when the path meets nothing.
+    bool sweptContact(const Vec3& p0, const Vec3& p1, double thickness, ContactPoint& out) const;
 
     const MovingContactStats& stats() const { return mStats; }
     // Clock the broad and narrow phase of every primitive (MovingContactStats; benchmarks).
@@ -116,6 +128,18 @@ private:
     // hold every primitive of this step within the slack limit (then mTreeOffset, mTreeSlack).
     bool treesStillHold();
     Vec3 faceNormal(bool atEnd, int tri) const;
+    // The first triangle the path p0 → p1 meets within opt.thickness over the prepared step
+    // (ties: the lower index), with the point's weights w at that time, the face's normal at the
+    // step's end on the side the vertex came from (the direction to the feature off a face's
+    // interior), and that point at the step's end. `cand`: scratch. Returns the candidates tested.
+    struct VertexHit {
+        int triangle = -1;
+        double time = 2.0;
+        double w[3] = {0.0, 0.0, 0.0};
+        Vec3 normal = Vec3::UnitY(), point = Vec3::Zero();
+    };
+    size_t vertexHit(const Vec3& p0, const Vec3& p1, const contact::CcdOptions& opt, double reach,
+                     std::vector<int>& cand, VertexHit& hit) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
     std::vector<std::array<int, 2>> mEdges; // unique body edges

@@ -6,6 +6,7 @@
 #include "solver/world/self_collision.h"
 
 #include "solver/bodies/cloth.h"
+#include "solver/bodies/hair.h"
 #include "solver/contact/ccd.h"
 #include "solver/contact/intersect.h"
 #include "solver/world/test_support.h"
@@ -328,4 +329,106 @@ TEST_CASE("self-collision: a start that intersects is reported and not made wors
         worst = std::max(worst, startPairs());
     }
     CHECK(worst <= at0);
+}
+
+namespace {
+
+struct PlumeRun {
+    int halvings = 0;         // substeps the World halved because the pass stretched cloth
+    double hairStretch = 0.0; // the strands' largest segment length over rest, any frame
+    int hairConstraints = 0;  // contact constraints the hair's solves held (summed)
+    long long ccdHits = 0, proximityPairs = 0; // what the pass still did
+    size_t crossings = 0; // strand segments through the sheet, summed over the frames
+    bool allAbove = true; // every strand vertex above the sheet at the end
+};
+
+// Five free strands (0.4 m, 10 segments) dropped from 0.3 m above a hammock (0.6 m, 13 × 13,
+// pinned along two opposite edges) land on it at 2.4 m/s and lie on it as it sags: 24 frames at
+// `substeps` a frame (as tests/cli/hair_cloth.sh).
+PlumeRun plumeOnHammock(bool inSolve, int substeps) {
+    WorldSettings ws;
+    ws.substeps = substeps;
+    ws.hairMeetsClothInSolve = inSolve;
+    World w(ws);
+    ClothMaterial m;
+    auto sheet = std::make_unique<Cloth>(
+        "sheet", makeGrid(0.6, 0.6, 13, 13, Vec3(-0.3, 1.0, -0.3), Vec3::UnitX(), Vec3::UnitZ()),
+        m);
+    PinSet pins;
+    for (int j = 0; j < 13; ++j)
+        for (int i : {0, 12}) pins.vertices.push_back(j * 13 + i);
+    sheet->addPins(pins);
+    sheet->collision().self = true;
+    sheet->collision().thickness = 0.005;
+    Strands s;
+    s.offsets.clear();
+    for (int k = 0; k < 5; ++k) {
+        s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+        for (int i = 0; i <= 10; ++i)
+            s.positions.insert(s.positions.end(), {-0.2 + 0.04 * i, 1.3, -0.1 + 0.05 * k});
+    }
+    s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+    HairMaterial hm;
+    hm.rootPinned = false;
+    auto hair = std::make_unique<Hair>("plume", s, hm);
+    hair->collision().self = true;
+    const Body* cloth = sheet.get();
+    const Body* plume = hair.get();
+    w.addBody(std::move(sheet));
+    w.addBody(std::move(hair));
+    PlumeRun r;
+    const auto& segments = plume->edges();
+    for (int f = 2; f <= 25; ++f) {
+        const FrameStats fs = w.advanceFrame(f);
+        REQUIRE_FALSE(fs.failed);
+        r.halvings += static_cast<int>(fs.selfContacts.halvings);
+        r.ccdHits += fs.selfContacts.ccdHits;
+        r.proximityPairs += fs.selfContacts.proximityPairs;
+        r.hairConstraints += fs.bodies[1].contactConstraints;
+        r.hairStretch = std::max(r.hairStretch, plume->maxEdgeStretch());
+        // Segments through the sheet's triangles (contact/intersect.h's segment test).
+        const VecX& x = plume->positions();
+        const VecX& c = cloth->positions();
+        for (const auto& e : segments)
+            for (const auto& t : *cloth->collisionTriangles())
+                r.crossings += contact::segmentCrossesTriangle(
+                    vec3At(x.data(), e[0]), vec3At(x.data(), e[1]), vec3At(c.data(), t[0]),
+                    vec3At(c.data(), t[1]), vec3At(c.data(), t[2]));
+    }
+    const VecX& x = plume->positions();
+    for (size_t i = 0; i < plume->vertexCount(); ++i) {
+        bool under = false;
+        r.allAbove = r.allAbove && aboveSheet(*cloth, vec3At(x.data(), i), under);
+    }
+    return r;
+}
+
+} // namespace
+
+// Issue 25, item 3 (hair against cloth in the solve): the strands meet the sheet in their own
+// solve, so the pass after it has little left to do and does not stretch them; before, the pass
+// pushed strand vertices out of the sheet after the solve, stretching their segments.
+TEST_CASE("self-collision: hair meets cloth in its own solve and not only in the pass",
+          "[solver][self]") {
+    for (int substeps : {1, 2}) {
+        CAPTURE(substeps);
+        const PlumeRun on = plumeOnHammock(true, substeps);
+        const PlumeRun off = plumeOnHammock(false, substeps);
+        INFO("in the solve: halvings " << on.halvings << ", hair stretch " << on.hairStretch
+                                       << ", constraints " << on.hairConstraints << ", ccd hits "
+                                       << on.ccdHits << ", proximity pairs " << on.proximityPairs);
+        INFO("pass alone: halvings " << off.halvings << ", hair stretch " << off.hairStretch
+                                     << ", ccd hits " << off.ccdHits << ", proximity pairs "
+                                     << off.proximityPairs);
+        CHECK(on.crossings == 0);
+        CHECK(on.allAbove);
+        CHECK(on.hairConstraints > 0);
+        CHECK(off.hairConstraints == 0);
+        CHECK(on.halvings == 0);
+        CHECK(on.hairStretch < 1.05);
+        CHECK(on.proximityPairs * 10 < off.proximityPairs);
+        CHECK(on.ccdHits * 10 < off.ccdHits + 10);
+        // The control: the pass alone stretches the strands (the measure can fail).
+        CHECK(off.hairStretch > 1.05);
+    }
 }

@@ -2,6 +2,9 @@
 // statistics, and the binary state used by `gale sim --resume`.
 #include "solver/world/world.h"
 
+#include "solver/collider/moving_collider.h"
+#include "solver/mesh/mesh_sequence.h"
+
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
@@ -74,16 +77,42 @@ void World::setUpSelfCollision(FrameStats& fs) {
         mSelfBodies.push_back(b);
     }
     if (mSelfBodies.empty()) return;
+    mClothBodies = mSelfBodies.size();
     // Hair that collides with cloth (collision().self on a body without triangles) joins the
     // pass when some cloth is in it: its segments against the cloth's triangles and edges.
     static const std::vector<std::array<int, 3>> kNone;
+    double hairThickness = 0.0;
     for (size_t b = 0; b < mBodies.size(); ++b) {
         Body& body = *mBodies[b];
         if (!body.collision().self || body.collisionTriangles()) continue;
         self->addBody(body, kNone, body.restPositions(), body.collision().thickness);
         mSelfBodies.push_back(b);
+        hairThickness = std::max(hairThickness, body.collision().thickness);
     }
     mSelf = std::move(self);
+    // Each cloth as a moving mesh the hair collides with in its solve (mClothContacts). The
+    // thickness the pass keeps between the two (the larger ξ of a pair's vertices); no
+    // friction, as in the pass.
+    if (mSelfBodies.size() > mClothBodies && mSettings.hairMeetsClothInSolve) {
+        mHairColliders = mColliders;
+        for (size_t k = 0; k < mClothBodies; ++k) {
+            const Body& cloth = *mBodies[mSelfBodies[k]];
+            const VecX& x = cloth.positions();
+            std::vector<double> p(x.data(), x.data() + x.size());
+            auto seq = std::make_shared<const MeshSequence>(
+                *cloth.collisionTriangles(), std::vector<std::vector<double>>{p}, 0, 24.0);
+            auto contact = std::make_shared<MovingMeshContact>(seq);
+            Collider c;
+            c.name = cloth.name();
+            c.shape = ColliderShape::Mesh;
+            c.moving = contact;
+            c.open = true;
+            c.thickness = std::max(hairThickness, cloth.collision().thickness);
+            c.friction = 0.0;
+            mHairColliders.push_back(std::move(c));
+            mClothContacts.push_back(std::move(contact));
+        }
+    }
     // A start that already intersects cannot be untangled; the passes keep it from worsening.
     const std::vector<int> start = mSelf->intersectionsPerBody();
     char buf[256];
@@ -118,21 +147,28 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
     // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
     // step, as the solver halves a substep in trouble; the level holds for the rest of the frame.
     int level = 0;
+    int streak = 0; // passes accepted at `level` since it last changed
     long tick = 0;
     while (tick < totalTicks) {
         const long end = std::min(totalTicks, tick + (ticksPerBase >> level));
         std::vector<BodyRun> runsBefore = runs;
+        const double tStart = t0 + dt * static_cast<double>(tick) / static_cast<double>(totalTicks);
+        const double tEnd = t0 + dt * static_cast<double>(end) / static_cast<double>(totalTicks);
         for (size_t k = 0; k < n; ++k) {
             Body& body = *mBodies[mSelfBodies[k]];
             snaps[k] = body.snapshot();
             starts[k] = body.positions();
             runs[k].level = std::max(runs[k].level, level);
-            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]]);
+            const bool hair = k >= mClothBodies;
+            if (hair && k == mClothBodies && !mClothContacts.empty())
+                clothAsColliders(starts, tStart, tEnd);
+            if (hair) body.forgetColliderBounds(); // the cloth's motion is new each interval
+            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]],
+                     hair && !mClothContacts.empty() ? &mHairColliders : nullptr);
             stretchBefore[k] = body.maxEdgeStretch();
         }
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
-        const double tEnd = t0 + dt * static_cast<double>(end) / static_cast<double>(totalTicks);
         bool stretched = false;
         double worst = 0.0;
         for (size_t k = 0; k < n; ++k) {
@@ -152,6 +188,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             }
             runs = runsBefore;
             ++level;
+            streak = 0;
             ++fs.selfContacts.halvings;
             std::snprintf(buf, sizeof buf,
                           "t=%.6g s: self-collision stretched cloth to %.3g × its rest length; "
@@ -168,12 +205,35 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
         tick = end;
+        // Grow back (WorldSettings::growBack), as stepBody does: two accepted passes at this
+        // level and a boundary of the coarser one.
+        ++streak;
+        if (mSettings.growBack && level > 0 && streak >= 2 &&
+            tick % (ticksPerBase >> (level - 1)) == 0) {
+            --level;
+            streak = 0;
+        }
     }
     const std::vector<int> pairs = mSelf->intersectionsPerBody();
     for (size_t k = 0; k < mSelfBodies.size(); ++k) {
         BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
         finishBodyStats(*mBodies[mSelfBodies[k]], t0 + dt, stats);
         stats.selfIntersections = pairs[k];
+    }
+}
+
+void World::clothAsColliders(const std::vector<VecX>& starts, double t0, double t1) {
+    // Two frames, at t0 and t1: fps = 1/(t1 − t0), frame 0 at t0 (MeshSequence's frame F is at
+    // (F − frameZero)/fps).
+    const double fps = 1.0 / (t1 - t0);
+    for (size_t k = 0; k < mClothContacts.size(); ++k) {
+        const Body& cloth = *mBodies[mSelfBodies[k]];
+        const VecX& x0 = starts[k];
+        const VecX& x1 = cloth.positions();
+        std::vector<std::vector<double>> frames{{x0.data(), x0.data() + x0.size()},
+                                                {x1.data(), x1.data() + x1.size()}};
+        mClothContacts[k]->setMesh(std::make_shared<const MeshSequence>(
+            mClothContacts[k]->mesh().triangles(), std::move(frames), 0, fps, -t0 * fps));
     }
 }
 
@@ -185,7 +245,7 @@ void World::advanceBody(Body& body, double t0, double dt, int substeps, BodyFram
 }
 
 void World::stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
-                     BodyFrameStats& stats) {
+                     BodyFrameStats& stats, const std::vector<Collider>* colliders) {
     stats.name = body.name();
     const int maxLevel = std::clamp(mSettings.maxHalvings, 0, 20);
     const long ticksPerBase = 1L << maxLevel;
@@ -194,7 +254,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
     env.wind = mWind.get();
     env.airDensity = mSettings.airDensity;
     env.gravity = mSettings.gravity;
-    env.colliders = &mColliders;
+    env.colliders = colliders ? colliders : &mColliders;
     env.fps = mSettings.fps;
     env.frameZero = mSettings.timeZero;
     env.threads = mSettings.threads;

@@ -43,6 +43,10 @@ struct WorldSettings {
     // Over-stretch or a velocity jump is answered by strain limiting the step (Body::recover,
     // as at the smallest substep) instead of a retry or halving (measured, not the default).
     bool strainLimitRetry = false;
+    // Hair that collides with cloth meets each cloth inside its own solve too (the cloth's motion
+    // over the interval as a moving mesh collider, World::clothAsColliders), not only in the
+    // self-collision pass after it. Off: the pass alone (measured against it).
+    bool hairMeetsClothInSolve = true;
 };
 
 // Per body, per frame.
@@ -135,11 +139,15 @@ private:
     };
     void advanceBody(Body& body, double t0, double dt, int substeps, BodyFrameStats& stats);
     // Steps `body` until `run.tick` reaches `untilTick` (ticks: 2^maxHalvings per base substep).
+    // `colliders`: what the body collides with (null: the scene's colliders).
     void stepBody(Body& body, double t0, double dt, int substeps, long untilTick, BodyRun& run,
-                  BodyFrameStats& stats);
+                  BodyFrameStats& stats, const std::vector<Collider>* colliders = nullptr);
     void finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const;
     void setUpSelfCollision(FrameStats& fs);
     void advanceColliding(double t0, double dt, int substeps, FrameStats& fs);
+    // The colliding cloth's motion over the interval [t0, t1] (from `starts`, their positions
+    // now) into mClothContacts, for the hair's solves.
+    void clothAsColliders(const std::vector<VecX>& starts, double t0, double t1);
 
     WorldSettings mSettings;
     fields::FieldPtr mWind;
@@ -150,6 +158,15 @@ private:
     std::unique_ptr<SelfCollision> mSelf;
     std::vector<size_t> mSelfBodies; // indices of the bodies in mSelf, in its order
     bool mSelfSetUp = false;
+    // Hair against the colliding cloth inside the hair's own solve, not only in the pass after
+    // it: the bodies of mSelfBodies step cloth first, so within an interval each cloth's motion
+    // is solved before the hair steps, and the hair collides with it as with a moving mesh
+    // (moving_collider.h: contact constraints in the solve, the continuous sweep after it).
+    // mClothBodies: how many of mSelfBodies are cloth (the first ones); mClothContacts: one
+    // per cloth; mHairColliders: the scene's colliders, then the cloth.
+    size_t mClothBodies = 0;
+    std::vector<std::shared_ptr<MovingMeshContact>> mClothContacts;
+    std::vector<Collider> mHairColliders;
 };
 
 } // namespace gale::solver
