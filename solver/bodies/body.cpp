@@ -587,12 +587,12 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             ContactPoint cp;
             bool found = endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
                          cp.distance < thick - kContactSlop;
-            // An open surface (Collider::open: a cloth the hair meets) the step's path went
-            // through, ending beyond it (its unsigned distance there can exceed ξ: the query
-            // above misses it): the continuous pass's vertex test, the face it met as a plane at
-            // the step's end (moving_collider.h, sweptContact), is the contact, so that the
+            // An open surface (MovingMeshContact::openSurface: a cloth the hair meets) the step's
+            // path went through, ending beyond it (its unsigned distance there can exceed ξ: the
+            // query above misses it): the continuous pass's vertex test, the face it met as a plane
+            // at the step's end (moving_collider.h, sweptContact), is the contact, so that the
             // solve, not the pass after it, stops the vertex on its side.
-            if (!found && c.moving && c.open)
+            if (!found && c.moving && c.moving->openSurface())
                 found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
                         cp.distance < 0.0;
             if (!found) continue;

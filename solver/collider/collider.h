@@ -30,9 +30,6 @@ struct Collider {
     // Mesh from a moving sequence (`mesh = "body.#.obj"`): its triangles, tree and CCD (shared
     // state, prepared per substep; then `mesh` is null).
     std::shared_ptr<MovingMeshContact> moving;
-    // A moving mesh that is an open surface (a cloth, World's hair against cloth): the solve
-    // also checks each vertex's path for crossing it (Body::updateContacts).
-    bool open = false;
     int line = 0, col = 0; // where the scene file wrote it (0: not from a file)
 };
 

@@ -479,20 +479,25 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             mStats.narrowSeconds += since(tb); // broad and narrow phase together here
             mStats.candidates += static_cast<long long>(candidates);
             if (hit.triangle < 0) continue;
-            // Placed ξ off the face's plane through the point it met (as that point is at the
-            // step's end), on the side it came from, with its tangential displacement from that
-            // point cut by Coulomb's bound on the position: by at most μ × the normal correction
-            // δ (μ = 0: lifted straight out, its own sliding kept — a path that only dipped
-            // within ξ/2 of a deforming surface is not dragged back along it; μ large: held at
-            // the point it met, which moves on with the surface).
+            // Placed ξ off the point it met, as that point is at the step's end, on the side it
+            // came from: held there, moving on with the surface. An open surface (a sagging
+            // cloth under hair): ξ off the face's plane through that point, its tangential
+            // displacement from it cut by Coulomb's bound on the position, at most μ × the
+            // normal correction δ (μ = 0: lifted straight out, its own slide kept, so a path
+            // that only dipped within ξ/2 of the deforming cloth is not dragged back along it).
             Eigen::Map<Vec3> x1i(x1.data() + 3 * i);
-            const Vec3 off = x1i - hit.point;
-            const double above = off.dot(hit.normal);
-            const Vec3 slide = off - above * hit.normal;
-            const double delta = std::max(0.0, placedAt(thickness) - above);
-            const double length = slide.norm();
-            const double keep = length > 0.0 ? std::max(0.0, 1.0 - friction * delta / length) : 0.0;
-            x1i = hit.point + std::max(above, placedAt(thickness)) * hit.normal + keep * slide;
+            if (mOpen) {
+                const Vec3 off = x1i - hit.point;
+                const double above = off.dot(hit.normal);
+                const Vec3 slide = off - above * hit.normal;
+                const double delta = std::max(0.0, placedAt(thickness) - above);
+                const double length = slide.norm();
+                const double keep =
+                    length > 0.0 ? std::max(0.0, 1.0 - friction * delta / length) : 0.0;
+                x1i = hit.point + std::max(above, placedAt(thickness)) * hit.normal + keep * slide;
+            } else {
+                x1i = hit.point + placedAt(thickness) * hit.normal;
+            }
             respond(static_cast<int>(i), surfaceVelocity(hit.triangle, hit.w), hit.normal);
             ++hits;
             ++mStats.vertexHits;

@@ -69,13 +69,14 @@ public:
     // The continuous pass over the prepared step for one body: vertex i moves from x0 to x1
     // (where `movable[i]`), edges and triangles as given (`triangles` empty for hair). Where a
     // vertex or an edge would come within `thickness` of the moving surface, it is placed at
-    // `thickness` off the surface it met, as that is at the step's end (a vertex: off the face's
-    // plane through the point it met, its slide from that point cut by μ × the normal
-    // correction), its approach speed removed (relative to the surface), and Coulomb friction μ
-    // applied to the tangential speed; where a body vertex would come within `thickness` of a cloth
-    // triangle, the triangle's movable corners are moved so that it ends `thickness` off the body
-    // vertex, on the side it started, with the same velocity response at the point it met. Repeated
-    // (at most `passes` times) until no motion meets the surface. Returns the vertices moved.
+    // `thickness` off the surface point it met, as that point is at the step's end (an open
+    // surface's vertex hit: off the face's plane through it, its slide from it cut by μ × the
+    // normal correction), its approach speed removed (relative to the surface), and Coulomb
+    // friction μ applied to the tangential speed; where a body vertex would come within `thickness`
+    // of a cloth triangle, the triangle's movable corners are moved so that it ends `thickness` off
+    // the body vertex, on the side it started, with the same velocity response at the point it met.
+    // Repeated (at most `passes` times) until no motion meets the surface. Returns the vertices
+    // moved.
     int sweep(const VecX& x0, VecX& x1, VecX& v1, const std::vector<uint8_t>& movable,
               const std::vector<std::array<int, 2>>& edges,
               const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
@@ -87,6 +88,13 @@ public:
     // vertex came from, `out.distance` the signed distance of p1 above that plane (negative:
     // beyond it), the surface velocity there. False when the path meets nothing.
     bool sweptContact(const Vec3& p0, const Vec3& p1, double thickness, ContactPoint& out) const;
+
+    // An open surface (a cloth as the hair's collider, World::clothAsColliders) rather than a
+    // body: the solve also tests vertex paths for crossing it (Body::updateContacts, an unsigned
+    // distance cannot tell), and a vertex hit in sweep() keeps its slide along the face, cut by
+    // Coulomb's bound (a body's hit holds the vertex at the point it met).
+    void setOpenSurface(bool open) { mOpen = open; }
+    bool openSurface() const { return mOpen; }
 
     const MovingContactStats& stats() const { return mStats; }
     // Clock the broad and narrow phase of every primitive (MovingContactStats; benchmarks).
@@ -142,6 +150,7 @@ private:
                      std::vector<int>& cand, VertexHit& hit) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
+    bool mOpen = false;                     // setOpenSurface
     std::vector<std::array<int, 2>> mEdges; // unique body edges
     std::vector<int> mVertices;             // body vertices in some triangle
     std::vector<double> mP0, mP1;           // corners at t0 and t1

@@ -102,11 +102,11 @@ void World::setUpSelfCollision(FrameStats& fs) {
             auto seq = std::make_shared<const MeshSequence>(
                 *cloth.collisionTriangles(), std::vector<std::vector<double>>{p}, 0, 24.0);
             auto contact = std::make_shared<MovingMeshContact>(seq);
+            contact->setOpenSurface(true);
             Collider c;
             c.name = cloth.name();
             c.shape = ColliderShape::Mesh;
             c.moving = contact;
-            c.open = true;
             c.thickness = std::max(hairThickness, cloth.collision().thickness);
             c.friction = 0.0;
             mHairColliders.push_back(std::move(c));
