@@ -37,8 +37,9 @@ struct WorldSettings {
     bool retryKeepCoarse = false;
     bool retryRepeat = false;
     // A halved substep grows back: after two accepted substeps at a level, at a boundary of
-    // the next coarser one, the step doubles again (down to the base size). Off: the halved
-    // step holds to the end of the frame.
+    // the next coarser one, the step doubles again (down to the base size); the same for the
+    // colliding bodies' interval halved for the self-collision pass. Off: the halved step holds
+    // to the end of the frame.
     bool growBack = false;
     // Over-stretch or a velocity jump is answered by strain limiting the step (Body::recover,
     // as at the smallest substep) instead of a retry or halving (measured, not the default).
