@@ -144,8 +144,9 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
     // Collisions resolved at the end of a substep move positions without the implicit solve
     // seeing it: a fast impact at a long substep then stretches cloth (stored energy the contact
     // never had). When a pass stretches an edge beyond both kPassStretch and kPassStretchGrowth
-    // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that interval at half the
-    // step, as the solver halves a substep in trouble; the level holds for the rest of the frame.
+    // × what the solve left (or beyond the over-stretch limit), the colliding bodies redo that
+    // interval at half the step, as the solver halves a substep in trouble; the level holds for the
+    // rest of the frame (or grows back, WorldSettings::growBack).
     int level = 0;
     int streak = 0; // passes accepted at `level` since it last changed
     long tick = 0;
@@ -159,12 +160,14 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             snaps[k] = body.snapshot();
             starts[k] = body.positions();
             runs[k].level = std::max(runs[k].level, level);
-            const bool hair = k >= mClothBodies;
-            if (hair && k == mClothBodies && !mClothContacts.empty())
-                clothAsColliders(starts, tStart, tEnd);
-            if (hair) body.forgetColliderBounds(); // the cloth's motion is new each interval
+            // Hair against the cloth's motion of this interval, solved just above.
+            const bool hairMeetsCloth = k >= mClothBodies && !mClothContacts.empty();
+            if (hairMeetsCloth) {
+                if (k == mClothBodies) clothAsColliders(starts, tStart, tEnd);
+                body.forgetColliderBounds(); // the cloth's motion is new each interval
+            }
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]],
-                     hair && !mClothContacts.empty() ? &mHairColliders : nullptr);
+                     hairMeetsCloth ? &mHairColliders : nullptr);
             stretchBefore[k] = body.maxEdgeStretch();
         }
         const SelfCollisionStats st = mSelf->resolve(starts);
