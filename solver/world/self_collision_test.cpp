@@ -340,12 +340,13 @@ struct PlumeRun {
     long long ccdHits = 0, proximityPairs = 0; // what the pass still did
     size_t crossings = 0; // strand segments through the sheet, summed over the frames
     bool allAbove = true; // every strand vertex above the sheet at the end
+    double sheetLowest = 0.0; // the sheet's lowest vertex height at the end (m)
 };
 
 // Five free strands (0.4 m, 10 segments) dropped from 0.3 m above a hammock (0.6 m, 13 × 13,
 // pinned along two opposite edges) land on it at 2.4 m/s and lie on it as it sags: 24 frames at
 // `substeps` a frame (as tests/cli/hair_cloth.sh).
-PlumeRun plumeOnHammock(bool inSolve, int substeps) {
+PlumeRun plumeOnHammock(bool inSolve, int substeps, double hairRadius = 4e-5) {
     WorldSettings ws;
     ws.substeps = substeps;
     ws.hairMeetsClothInSolve = inSolve;
@@ -370,6 +371,7 @@ PlumeRun plumeOnHammock(bool inSolve, int substeps) {
     s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
     HairMaterial hm;
     hm.rootPinned = false;
+    hm.radius = hairRadius;
     auto hair = std::make_unique<Hair>("plume", s, hm);
     hair->collision().self = true;
     const Body* cloth = sheet.get();
@@ -395,6 +397,10 @@ PlumeRun plumeOnHammock(bool inSolve, int substeps) {
                     vec3At(x.data(), e[0]), vec3At(x.data(), e[1]), vec3At(c.data(), t[0]),
                     vec3At(c.data(), t[1]), vec3At(c.data(), t[2]));
     }
+    const VecX& c = cloth->positions();
+    r.sheetLowest = INFINITY;
+    for (size_t i = 0; i < cloth->vertexCount(); ++i)
+        r.sheetLowest = std::min(r.sheetLowest, c[3 * i + 1]);
     const VecX& x = plume->positions();
     for (size_t i = 0; i < plume->vertexCount(); ++i) {
         bool under = false;
@@ -431,4 +437,18 @@ TEST_CASE("self-collision: hair meets cloth in its own solve and not only in the
         // The control: the pass alone stretches the strands (the measure can fail).
         CHECK(off.hairStretch > 1.05);
     }
+}
+
+// Only light hair meets a cloth in its solve (the cloth does not feel it there): 2 mm braids as
+// heavy as the hammock are left to the pass, which shares each correction by inverse mass, so the
+// hammock carries them and sags further than under the light plume.
+TEST_CASE("self-collision: hair as heavy as the cloth is left to the pass", "[solver][self]") {
+    const PlumeRun light = plumeOnHammock(true, 2);
+    const PlumeRun heavy = plumeOnHammock(true, 2, 2e-3);
+    INFO("sheet lowest: light " << light.sheetLowest << " m, heavy " << heavy.sheetLowest << " m");
+    CHECK(light.hairConstraints > 0);
+    CHECK(heavy.hairConstraints == 0); // no collider but the cloth: none held in the solve
+    CHECK(heavy.crossings == 0);
+    CHECK(heavy.allAbove);
+    CHECK(heavy.sheetLowest < light.sheetLowest - 0.01);
 }

@@ -22,6 +22,8 @@ namespace {
 // kPassStretchGrowth × what the solve left has its interval redone at half the step.
 constexpr double kPassStretch = 1.1;
 constexpr double kPassStretchGrowth = 1.05;
+// A hair meets a cloth in its own solve only when it weighs at most this share of the cloth.
+constexpr double kHairMassShare = 0.05;
 } // namespace
 
 struct World::Arena {
@@ -81,20 +83,19 @@ void World::setUpSelfCollision(FrameStats& fs) {
     // Hair that collides with cloth (collision().self on a body without triangles) joins the
     // pass when some cloth is in it: its segments against the cloth's triangles and edges.
     static const std::vector<std::array<int, 3>> kNone;
-    double hairThickness = 0.0;
     for (size_t b = 0; b < mBodies.size(); ++b) {
         Body& body = *mBodies[b];
         if (!body.collision().self || body.collisionTriangles()) continue;
         self->addBody(body, kNone, body.restPositions(), body.collision().thickness);
         mSelfBodies.push_back(b);
-        hairThickness = std::max(hairThickness, body.collision().thickness);
     }
     mSelf = std::move(self);
-    // Each cloth as a moving mesh the hair collides with in its solve (mClothContacts). The
-    // thickness the pass keeps between the two (the larger ξ of a pair's vertices); no
-    // friction, as in the pass.
+    // Each cloth as a moving mesh a hair collides with in its solve (mClothContacts), where the
+    // hair is light against it (kHairMassShare: the cloth does not feel the hair in its solve);
+    // per hair, its list (mHairColliders). The thickness the pass keeps between the two (the
+    // larger ξ of a pair's vertices); no friction, as in the pass.
     if (mSelfBodies.size() > mClothBodies && mSettings.hairMeetsClothInSolve) {
-        mHairColliders = mColliders;
+        const auto mass = [](const Body& b) { return b.masses().sum(); };
         for (size_t k = 0; k < mClothBodies; ++k) {
             const Body& cloth = *mBodies[mSelfBodies[k]];
             const VecX& x = cloth.positions();
@@ -103,14 +104,24 @@ void World::setUpSelfCollision(FrameStats& fs) {
                 *cloth.collisionTriangles(), std::vector<std::vector<double>>{p}, 0, 24.0);
             auto contact = std::make_shared<MovingMeshContact>(seq);
             contact->setOpenSurface(true);
-            Collider c;
-            c.name = cloth.name();
-            c.shape = ColliderShape::Mesh;
-            c.moving = contact;
-            c.thickness = std::max(hairThickness, cloth.collision().thickness);
-            c.friction = 0.0;
-            mHairColliders.push_back(std::move(c));
             mClothContacts.push_back(std::move(contact));
+        }
+        mHairColliders.assign(mSelfBodies.size() - mClothBodies, {});
+        for (size_t h = mClothBodies; h < mSelfBodies.size(); ++h) {
+            const Body& hair = *mBodies[mSelfBodies[h]];
+            std::vector<Collider>& list = mHairColliders[h - mClothBodies];
+            for (size_t k = 0; k < mClothBodies; ++k) {
+                const Body& cloth = *mBodies[mSelfBodies[k]];
+                if (!(mass(hair) <= kHairMassShare * mass(cloth))) continue;
+                if (list.empty()) list = mColliders;
+                Collider c;
+                c.name = cloth.name();
+                c.shape = ColliderShape::Mesh;
+                c.moving = mClothContacts[k];
+                c.thickness = std::max(hair.collision().thickness, cloth.collision().thickness);
+                c.friction = 0.0;
+                list.push_back(std::move(c));
+            }
         }
     }
     // A start that already intersects cannot be untangled; the passes keep it from worsening.
@@ -155,19 +166,22 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         std::vector<BodyRun> runsBefore = runs;
         const double tStart = t0 + dt * static_cast<double>(tick) / static_cast<double>(totalTicks);
         const double tEnd = t0 + dt * static_cast<double>(end) / static_cast<double>(totalTicks);
+        bool movedCloth = false; // mClothContacts hold this interval's motion
         for (size_t k = 0; k < n; ++k) {
             Body& body = *mBodies[mSelfBodies[k]];
             snaps[k] = body.snapshot();
             starts[k] = body.positions();
             runs[k].level = std::max(runs[k].level, level);
             // Hair against the cloth's motion of this interval, solved just above.
-            const bool hairMeetsCloth = k >= mClothBodies && !mClothContacts.empty();
+            const bool hairMeetsCloth = k >= mClothBodies && !mClothContacts.empty() &&
+                                        !mHairColliders[k - mClothBodies].empty();
             if (hairMeetsCloth) {
-                if (k == mClothBodies) clothAsColliders(starts, tStart, tEnd);
+                if (!movedCloth) clothAsColliders(starts, tStart, tEnd);
+                movedCloth = true;
                 body.forgetColliderBounds(); // the cloth's motion is new each interval
             }
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]],
-                     hairMeetsCloth ? &mHairColliders : nullptr);
+                     hairMeetsCloth ? &mHairColliders[k - mClothBodies] : nullptr);
             stretchBefore[k] = body.maxEdgeStretch();
         }
         const SelfCollisionStats st = mSelf->resolve(starts);

@@ -164,10 +164,11 @@ private:
     // is solved before the hair steps, and the hair collides with it as with a moving mesh
     // (moving_collider.h: contact constraints in the solve, the continuous sweep after it).
     // mClothBodies: how many of mSelfBodies are cloth (the first ones); mClothContacts: one
-    // per cloth; mHairColliders: the scene's colliders, then the cloth.
+    // per cloth; mHairColliders: per hair (mSelfBodies after the cloth), the scene's colliders
+    // then the cloth it is light against (empty: none, the pass alone).
     size_t mClothBodies = 0;
     std::vector<std::shared_ptr<MovingMeshContact>> mClothContacts;
-    std::vector<Collider> mHairColliders;
+    std::vector<std::vector<Collider>> mHairColliders;
 };
 
 } // namespace gale::solver
