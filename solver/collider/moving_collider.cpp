@@ -79,6 +79,15 @@ bool clearAtFirstAdvance(const Vec3 x[4], const Vec3 x1[4], int firstCount, doub
     return opt.stepFraction * (lower - xi) >= lp * (1.0 + 1e-9);
 }
 
+// The continuous pass's CCD for a primitive held ξ off the surface (sweep(), sweptContact()):
+// motions kept ξ/2 from it, and one already within that at the start only kept from crossing.
+contact::CcdOptions sweepOptions(double xi) {
+    contact::CcdOptions o;
+    o.thickness = 0.5 * xi;
+    o.shrinkWithinThickness = true;
+    return o;
+}
+
 double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
     return std::sqrt((alo - bhi).cwiseMax(blo - ahi).cwiseMax(0.0).squaredNorm());
 }
@@ -360,9 +369,7 @@ size_t MovingMeshContact::vertexHit(const Vec3& p0, const Vec3& p1, const contac
 bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thickness,
                                      ContactPoint& out) const {
     if (!mBuilt || !p0.allFinite() || !p1.allFinite()) return false;
-    contact::CcdOptions opt;
-    opt.thickness = 0.5 * thickness; // as the continuous pass (sweep)
-    opt.shrinkWithinThickness = true;
+    const contact::CcdOptions opt = sweepOptions(thickness);
     std::vector<int> cand;
     VertexHit hit;
     vertexHit(p0, p1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
@@ -405,12 +412,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
     // For a primitive held off the body by ξ: the CCD's options, and the distance a hit is
     // placed at (ξ and ξ/2 as above; ξ_e below for pinned vertices within the thickness).
-    const auto optionsFor = [](double xi) {
-        contact::CcdOptions o;
-        o.thickness = 0.5 * xi;
-        o.shrinkWithinThickness = true;
-        return o;
-    };
+    const auto optionsFor = sweepOptions;
     const auto placedAt = [](double xi) { return xi * (1.0 + 1e-6) + 1e-9; };
     const contact::CcdOptions opt = optionsFor(thickness);
     // The broad phase's reach: the CCD asks for at most ξ/2 (less for pinned corners), and the
