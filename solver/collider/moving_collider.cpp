@@ -88,6 +88,10 @@ contact::CcdOptions sweepOptions(double xi) {
     return o;
 }
 
+Vec3 lerp(const Vec3& a, const Vec3& b, double t) {
+    return a + t * (b - a);
+}
+
 double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
     return std::sqrt((alo - bhi).cwiseMax(blo - ahi).cwiseMax(0.0).squaredNorm());
 }
@@ -112,6 +116,17 @@ void MovingMeshContact::setMesh(std::shared_ptr<const MeshSequence> mesh) {
 
 Vec3 MovingMeshContact::corner(bool atEnd, int v) const {
     return vec3At((atEnd ? mP1 : mP0).data(), v);
+}
+
+Vec3 MovingMeshContact::pointVelocity(int tri, const double w[3], double h) const {
+    Vec3 v = Vec3::Zero();
+    if (h > 0.0)
+        for (int c = 0; c < 3; ++c)
+            v += w[c] *
+                 (corner(true, mMesh->triangles()[tri][c]) -
+                  corner(false, mMesh->triangles()[tri][c])) /
+                 h;
+    return v;
 }
 
 Vec3 MovingMeshContact::faceNormal(bool atEnd, int tri) const {
@@ -264,19 +279,15 @@ bool MovingMeshContact::closest(const Vec3& x, bool atEnd, double radius, Contac
                       [&](int k, const contact::Box&) { consider(k); });
     if (bestTri < 0) return false;
     const auto& t = tris[bestTri];
-    Vec3 p = Vec3::Zero(), v = Vec3::Zero();
-    const double h = mT1 - mT0;
-    for (int c = 0; c < 3; ++c) {
-        p += bestW[c] * corner(atEnd, t[c]);
-        if (h > 0.0) v += bestW[c] * (corner(true, t[c]) - corner(false, t[c])) / h;
-    }
+    Vec3 p = Vec3::Zero();
+    for (int c = 0; c < 3; ++c) p += bestW[c] * corner(atEnd, t[c]);
     const Vec3 d = x - p;
     const double dist = d.norm();
     const Vec3 fn = faceNormal(atEnd, bestTri);
     out.distance = dist;
     out.triangle = bestTri;
     out.normal = dist > 1e-12 ? Vec3(d / dist) : fn;
-    out.velocity = v;
+    out.velocity = pointVelocity(bestTri, bestW, mT1 - mT0);
     return true;
 }
 
@@ -313,16 +324,20 @@ bool MovingMeshContact::nearestVertex(const Vec3& a, const Vec3& b, const Vec3& 
     return true;
 }
 
-size_t MovingMeshContact::vertexHit(const Vec3& p0, const Vec3& p1, const contact::CcdOptions& opt,
-                                    double reach, std::vector<int>& cand,
-                                    MovingMeshContact::VertexHit& hit) const {
-    hit = VertexHit{};
+void MovingMeshContact::vertexCandidates(const Vec3& p0, const Vec3& p1, double reach,
+                                         std::vector<int>& cand) const {
     contact::Box q;
     addSwept(q, p0, p1);
     q.inflate(reach);
     cand.clear();
     mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
     std::sort(cand.begin(), cand.end()); // triangle order: a fixed tie-break
+}
+
+MovingMeshContact::VertexHit
+MovingMeshContact::firstVertexHit(const Vec3& p0, const Vec3& p1, const std::vector<int>& cand,
+                                  const contact::CcdOptions& opt) const {
+    VertexHit hit;
     const auto& tris = mMesh->triangles();
     double first = 2.0;
     for (int k : cand) {
@@ -341,8 +356,7 @@ size_t MovingMeshContact::vertexHit(const Vec3& p0, const Vec3& p1, const contac
             hit.triangle = k;
         }
     }
-    if (hit.triangle < 0) return cand.size();
-    const auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
+    if (hit.triangle < 0) return hit;
     const auto& t = tris[hit.triangle];
     const Vec3 a = lerp(corner(false, t[0]), corner(true, t[0]), first),
                b = lerp(corner(false, t[1]), corner(true, t[1]), first),
@@ -362,8 +376,7 @@ size_t MovingMeshContact::vertexHit(const Vec3& p0, const Vec3& p1, const contac
     const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
     if (!interior) hit.normal = nt.normalized();
     hit.point = w[0] * corner(true, t[0]) + w[1] * corner(true, t[1]) + w[2] * corner(true, t[2]);
-    hit.time = first;
-    return cand.size();
+    return hit;
 }
 
 bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thickness,
@@ -371,17 +384,12 @@ bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thic
     if (!mBuilt || !p0.allFinite() || !p1.allFinite()) return false;
     const contact::CcdOptions opt = sweepOptions(thickness);
     std::vector<int> cand;
-    VertexHit hit;
-    vertexHit(p0, p1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
+    vertexCandidates(p0, p1, opt.thickness + 2.0 * opt.gapTolerance, cand);
+    const VertexHit hit = firstVertexHit(p0, p1, cand, opt);
     if (hit.triangle < 0) return false;
-    const auto& t = mMesh->triangles()[hit.triangle];
     out.distance = (p1 - hit.point).dot(hit.normal);
     out.normal = hit.normal;
-    out.velocity = Vec3::Zero();
-    const double h = mT1 - mT0;
-    if (h > 0.0)
-        for (int k = 0; k < 3; ++k)
-            out.velocity += hit.w[k] * (corner(true, t[k]) - corner(false, t[k])) / h;
+    out.velocity = pointVelocity(hit.triangle, hit.w, mT1 - mT0);
     out.triangle = hit.triangle;
     return true;
 }
@@ -403,7 +411,6 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
         return mDetailedTiming ? seconds(t) : 0.0;
     };
     const size_t n = x0.size() / 3;
-    const auto& tris = mMesh->triangles();
     // The continuous pass keeps motions from coming closer than half the thickness (a crossing
     // needs less); hits are placed at the full thickness, so that a re-check of the corrected
     // motion has half the thickness to spare (no re-hit on resting contact), and the push-out
@@ -412,9 +419,8 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
     // For a primitive held off the body by ξ: the CCD's options, and the distance a hit is
     // placed at (ξ and ξ/2 as above; ξ_e below for pinned vertices within the thickness).
-    const auto optionsFor = sweepOptions;
     const auto placedAt = [](double xi) { return xi * (1.0 + 1e-6) + 1e-9; };
-    const contact::CcdOptions opt = optionsFor(thickness);
+    const contact::CcdOptions opt = sweepOptions(thickness);
     // The broad phase's reach: the CCD asks for at most ξ/2 (less for pinned corners), and the
     // swept boxes hold each primitive throughout the step (its points are convex combinations
     // of its corners at both ends), so a pair whose boxes are farther apart than ξ/2 stays
@@ -444,14 +450,6 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             ++movedCount;
         }
     };
-    auto surfaceVelocity = [&](int tri, const double w[3]) {
-        Vec3 vs = Vec3::Zero();
-        if (h > 0.0)
-            for (int c = 0; c < 3; ++c)
-                vs += w[c] * (corner(true, tris[tri][c]) - corner(false, tris[tri][c])) / h;
-        return vs;
-    };
-    auto lerp = [](const Vec3& a, const Vec3& b, double t) { return Vec3(a + t * (b - a)); };
     // Pinned vertices within the thickness (a hair root on the scalp, a collar sewn closer than
     // ξ): their clearance over the step, the most an edge or triangle they carry can be held off.
     std::vector<double> pinClear;
@@ -476,10 +474,12 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
             if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
             auto tb = tick();
-            VertexHit hit;
-            const size_t candidates = vertexHit(p0, p1, opt, reach, cand, hit);
-            mStats.narrowSeconds += since(tb); // broad and narrow phase together here
-            mStats.candidates += static_cast<long long>(candidates);
+            vertexCandidates(p0, p1, reach, cand);
+            mStats.broadSeconds += since(tb);
+            mStats.candidates += static_cast<long long>(cand.size());
+            auto tn = tick();
+            const VertexHit hit = firstVertexHit(p0, p1, cand, opt);
+            mStats.narrowSeconds += since(tn);
             if (hit.triangle < 0) continue;
             // Placed ξ off the point it met, as that point is at the step's end, on the side it
             // came from: held there, moving on with the surface. An open surface (a sagging
@@ -500,7 +500,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             } else {
                 x1i = hit.point + placedAt(thickness) * hit.normal;
             }
-            respond(static_cast<int>(i), surfaceVelocity(hit.triangle, hit.w), hit.normal);
+            respond(static_cast<int>(i), pointVelocity(hit.triangle, hit.w, h), hit.normal);
             ++hits;
             ++mStats.vertexHits;
         }
@@ -509,7 +509,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const int i = e[0], j = e[1];
             if (!movable[i] && !movable[j]) continue;
             const double xiE = std::min(clearanceOf(i), clearanceOf(j));
-            const contact::CcdOptions optE = optionsFor(xiE);
+            const contact::CcdOptions optE = sweepOptions(xiE);
             const double wantE = placedAt(xiE);
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
@@ -607,7 +607,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!finite) continue; // left to the trouble detector
             const double xiT =
                 std::min({clearanceOf(tv[0]), clearanceOf(tv[1]), clearanceOf(tv[2])});
-            const contact::CcdOptions optT = optionsFor(xiT);
+            const contact::CcdOptions optT = sweepOptions(xiT);
             const double wantT = placedAt(xiT);
             auto tb = tick();
             contact::Box q;

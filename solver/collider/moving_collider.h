@@ -136,18 +136,23 @@ private:
     // hold every primitive of this step within the slack limit (then mTreeOffset, mTreeSlack).
     bool treesStillHold();
     Vec3 faceNormal(bool atEnd, int tri) const;
-    // The first triangle the path p0 → p1 meets within opt.thickness over the prepared step
-    // (ties: the lower index), with the point's weights w at that time, the face's normal at the
-    // step's end on the side the vertex came from (the direction to the feature off a face's
-    // interior), and that point at the step's end. `cand`: scratch. Returns the candidates tested.
+    // The surface velocity (m/s) of triangle tri's point with weights w over a step of h s.
+    Vec3 pointVelocity(int tri, const double w[3], double h) const;
+    // The continuous pass's vertex test, broad phase: the triangles whose swept boxes come
+    // within `reach` of the path p0 → p1's, in triangle order (a fixed tie-break).
+    void vertexCandidates(const Vec3& p0, const Vec3& p1, double reach,
+                          std::vector<int>& cand) const;
+    // And its narrow phase: the first of `cand` the path meets within opt.thickness over the
+    // prepared step (ties: the lower index), with the point's weights w at that time, the
+    // face's normal at the step's end on the side the vertex came from (the direction to the
+    // feature off a face's interior), and that point at the step's end; triangle −1: none.
     struct VertexHit {
         int triangle = -1;
-        double time = 2.0;
         double w[3] = {0.0, 0.0, 0.0};
         Vec3 normal = Vec3::UnitY(), point = Vec3::Zero();
     };
-    size_t vertexHit(const Vec3& p0, const Vec3& p1, const contact::CcdOptions& opt, double reach,
-                     std::vector<int>& cand, VertexHit& hit) const;
+    VertexHit firstVertexHit(const Vec3& p0, const Vec3& p1, const std::vector<int>& cand,
+                             const contact::CcdOptions& opt) const;
 
     std::shared_ptr<const MeshSequence> mMesh;
     bool mOpen = false;                     // setOpenSurface
