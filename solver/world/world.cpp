@@ -172,16 +172,15 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             snaps[k] = body.snapshot();
             starts[k] = body.positions();
             runs[k].level = std::max(runs[k].level, level);
-            // Hair against the cloth's motion of this interval, solved just above.
-            const bool hairMeetsCloth = k >= mClothBodies && !mClothContacts.empty() &&
-                                        !mHairColliders[k - mClothBodies].empty();
-            if (hairMeetsCloth) {
+            // A hair that meets cloth in its solve: against the cloth's motion of this interval,
+            // solved just above.
+            const std::vector<Collider>* own = hairColliders(k);
+            if (own) {
                 if (!movedCloth) clothAsColliders(starts, tStart, tEnd);
                 movedCloth = true;
                 body.forgetColliderBounds(); // the cloth's motion is new each interval
             }
-            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]],
-                     hairMeetsCloth ? &mHairColliders[k - mClothBodies] : nullptr);
+            stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
         const SelfCollisionStats st = mSelf->resolve(starts);
@@ -237,6 +236,12 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         finishBodyStats(*mBodies[mSelfBodies[k]], t0 + dt, stats);
         stats.selfIntersections = pairs[k];
     }
+}
+
+const std::vector<Collider>* World::hairColliders(size_t k) const {
+    if (k < mClothBodies || k - mClothBodies >= mHairColliders.size()) return nullptr;
+    const std::vector<Collider>& list = mHairColliders[k - mClothBodies];
+    return list.empty() ? nullptr : &list;
 }
 
 void World::clothAsColliders(const std::vector<VecX>& starts, double t0, double t1) {

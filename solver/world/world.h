@@ -149,6 +149,9 @@ private:
     // The colliding cloth's motion over the interval [t0, t1] (from `starts`, their positions
     // now) into mClothContacts, for the hair's solves.
     void clothAsColliders(const std::vector<VecX>& starts, double t0, double t1);
+    // What the body k of mSelfBodies collides with in its solve when it is a hair that meets
+    // some cloth there (mHairColliders); null: the scene's colliders.
+    const std::vector<Collider>* hairColliders(size_t k) const;
 
     WorldSettings mSettings;
     fields::FieldPtr mWind;
