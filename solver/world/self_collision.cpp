@@ -547,7 +547,6 @@ int SelfCollision::proximity() {
                 if (!(d1 < xi) && !(d0 < xi)) return;
                 if (restClose(p, vt) || neighbours(p, vt)) return;
                 Vec3 n;
-                double startGap = INFINITY; // measured in the end's frame: its distance at x₀
                 if (d0 > kTouching) {
                     n = contactNormal(mX0, p0, vt, r0, d0);
                     const Vec3 n1 =
@@ -561,7 +560,6 @@ int SelfCollision::proximity() {
                         // up to 10 % of its length to such pushes.
                         if (!(d1 < xi)) return;
                         n = n1;
-                        startGap = d0;
                     } else if (d0 < xi) {
                         p = p0; // the start's closest points: it keeps the side it started on
                     }
@@ -573,9 +571,8 @@ int SelfCollision::proximity() {
                 // A pair already closer than ξ at the start (resting contact, a pile) is kept from
                 // closing further and eased a quarter of the way back to ξ per substep: pushing
                 // it the whole way every substep fights gravity and the cloth's own elasticity
-                // and ratchets strain up in a resting pile. (A pair measured in the end's frame:
-                // its own distance at x₀ when that is less, so a resting pair is eased as before.)
-                const double g0 = std::min(n.dot(relative(mX0, p)), startGap);
+                // and ratchets strain up in a resting pile.
+                const double g0 = n.dot(relative(mX0, p));
                 const double target =
                     g0 < xi ? std::max(0.0, g0) + kEase * (xi - std::max(0.0, g0)) : xi;
                 out.push_back({p, n, target});
