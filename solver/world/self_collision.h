@@ -78,6 +78,12 @@ public:
     };
 
 private:
+    // A pair to correct: proximity's (kept ξ apart) or a CCD hit's.
+    struct Contact {
+        Pair pair;
+        Vec3 n;        // unit: the side the pair keeps (from the second part towards the first)
+        double target; // the relative normal gap (m) or displacement the correction enforces
+    };
     void gather();
     void scatter();
     // Boxes of the primitives over their vertices' boxes [lo, hi] (3 per vertex each),
@@ -142,6 +148,7 @@ private:
     std::vector<uint8_t> mMaybe[2];
     bool mMaybeValid = false;
     std::vector<Pair> mLastHits; // of the last CCD round
+    std::vector<Contact> mContacts; // proximity's pairs, or a CCD round's hits (reused buffer)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     bool mBuilt = false;
     long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild
