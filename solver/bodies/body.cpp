@@ -352,7 +352,10 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     mFrictionPrev.assign(2 * n, 0.0);
     mFrictionInA.assign(n, 0.0);
     mFrictionAxis.setZero(3 * n);
-    if (!env.colliders || env.colliders->empty()) return;
+    if (!env.colliders || env.colliders->empty()) {
+        applyClothPlanes(t, h);
+        return;
+    }
     for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
         const Collider& c = (*env.colliders)[ci];
         const double thick = mKin.colliders[ci].thickness;
@@ -437,6 +440,38 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             }
         }
     }
+    applyClothPlanes(t, h);
+}
+
+// Cloth against cloth in the solve (World, WorldSettings::clothContactInSolve): a free vertex
+// resting on other cloth at the step's start (ClothContactPlane), predicted to move towards it,
+// gets the sliding contact a collider gives (setContact: S = I − nnᵀ, no friction), against the
+// plane n·x = n·p + g through the other cloth's point p moving at the pair's centre-of-mass
+// velocity u, g its gap there clamped to [0, ξ]: it may slide and leave, not close in. Not pushed
+// out to ξ (the pass after the solve eases a resting pair back a quarter of the way a substep):
+// pushed here, a pile gained energy each substep. The constraint is released as any contact's
+// when its force would pull (updateContacts); its index is one past the colliders (no query).
+void Body::applyClothPlanes(double t, double h) {
+    const double xi = mCollision.thickness;
+    const int index = static_cast<int>(mKin.colliders.size());
+    for (const ClothContactPlane& plane : mClothPlanes) {
+        const size_t i = static_cast<size_t>(plane.vertex);
+        if (i >= vertexCount() || mConstraints.kind[i] != 0) continue;
+        const Vec3 x = vec3At(mX.data(), i);
+        const Vec3 v0 = vec3At(mV.data(), i);
+        const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - plane.velocity;
+        const double un = pred.dot(plane.normal);
+        if (!(un < 0.0)) continue;
+        ContactPoint cp;
+        cp.normal = plane.normal;
+        cp.distance = plane.normal.dot(x - plane.point);
+        if (!(cp.distance >= 0.0)) continue; // beyond it already: the pass's, not pushed here
+        cp.velocity = plane.velocity;
+        setContact(i, index, cp, x, t, std::min(cp.distance, xi), t + h, h, mX, mV, v0, false);
+        mContactMu[i] = 0.0;
+        mContactImpulse[i] = -un;
+    }
+    mClothPlanes.clear();
 }
 
 bool Body::endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp) {
@@ -513,8 +548,11 @@ void Body::contactRhs(double h) {
 // Returns the number of changes (each asks for another solve).
 int Body::updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                          SubstepStatus& st) {
-    if (!env.colliders || env.colliders->empty()) return 0;
     const size_t n = vertexCount();
+    // Without colliders, cloth held against cloth (applyClothPlanes) is still released here.
+    const bool held = std::any_of(mContactCollider.begin(), mContactCollider.begin() + n,
+                                  [](int c) { return c >= 0; });
+    if ((!env.colliders || env.colliders->empty()) && !held) return 0;
     int changes = 0;
     mTmp.resize(3 * n);
     mA.multiply(mDv.data(), mTmp.data());

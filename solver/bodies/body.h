@@ -214,6 +214,17 @@ struct ForceOutput {
     bool skewed = false; // some element's coupling has a skew part (the solve corrects for it)
 };
 
+// A plane that holds a cloth vertex in its own solve against another piece of cloth (its own or
+// another's) it rests on or against: the self-collision pass's resting pair at the step's start
+// (SelfCollision::contactPlanes). The vertex may not come closer to `point` along `normal` than it
+// starts (at most ξ), the plane moving at `velocity`.
+struct ClothContactPlane {
+    int vertex = -1; // the body's vertex
+    Vec3 normal;     // unit, from the other cloth towards the vertex
+    Vec3 point;      // m: the other cloth's closest point at the step's start
+    Vec3 velocity;   // m/s: the pair's centre-of-mass velocity (an inelastic meeting)
+};
+
 class Body {
 public:
     virtual ~Body() = default;
@@ -233,6 +244,8 @@ public:
     StepOptions& options() { return mOptions; }
     const StepOptions& options() const { return mOptions; }
     TroubleLimits& limits() { return mLimits; }
+    // The cloth contact planes for the next substep (World, cloth against cloth in the solve).
+    void setClothPlanes(std::vector<ClothContactPlane> planes) { mClothPlanes = std::move(planes); }
     CollisionSettings& collision() { return mCollision; }
     const CollisionSettings& collision() const { return mCollision; }
     // The triangles cloth–cloth contact sees (null: a body without a surface, e.g. hair).
@@ -314,6 +327,10 @@ private:
     // Everything scripted for the substep [t, t + h] into mKin (kinematics.h), once.
     void evaluateKinematics(const Environment& env, double t, double h);
     void contactConstraints(const Environment& env, double t, double h);
+    // Cloth against cloth in the solve: the planes the next substep's contactConstraints turns
+    // into sliding constraints (applyClothPlanes), then forgets.
+    std::vector<ClothContactPlane> mClothPlanes;
+    void applyClothPlanes(double t, double h);
     void setContact(size_t i, int collider, const ContactPoint& cp, const Vec3& p, double tq,
                     double thick, double t1, double h, const VecX& x0, const VecX& v0,
                     const Vec3& path, bool stick);

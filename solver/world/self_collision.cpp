@@ -578,6 +578,10 @@ int SelfCollision::proximity() {
             contacts);
     }
     mMaybeValid = true;
+    mResting.clear();
+    for (const Contact& c : contacts)
+        if (c.pair.a[0] == 1.0 && c.pair.a[1] <= 0.0 && c.pair.a[2] <= 0.0 && c.pair.a[3] <= 0.0)
+            mResting.push_back(c); // vertex–triangle (α = 1, −w₀, −w₁, −w₂)
     for (int it = 0; it < mSettings.proximityIterations; ++it)
         for (const Contact& c : contacts) {
             const double g = c.n.dot(relative(mX1, c.pair));
@@ -846,6 +850,56 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
     ++mPasses;
     scatter();
     return mStats;
+}
+
+std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const {
+    // For a pair of vertex v (mass m_v, velocity v_v) and triangle point q = Σ w_k x_k (mass
+    // m_t = Σ w_k m_k, velocity v_t = Σ w_k v_k), both sides meet at the centre-of-mass velocity
+    // u = (m_v v_v + m_t v_t) / (m_v + m_t), as in an inelastic collision: v gets the plane
+    // through q with the pair's normal n, the corners the plane through x_v with −n, both moving
+    // at u. Of several planes a vertex keeps the one it is nearest (ties: the first pair).
+    const size_t n = mVertexBody.size();
+    std::vector<double> nearest(n, INFINITY);
+    std::vector<ClothContactPlane> plane(n);
+    const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
+    const auto offer = [&](int i, const Vec3& nrm, const Vec3& point, const Vec3& velocity) {
+        if (mInvMass[i] == 0.0) return;
+        const double gap = nrm.dot(at(mX1, i) - point);
+        // A corner beyond the vertex along n (a tilted face under a vertex near its edge) is not
+        // held: its plane would push it back by as much.
+        if (!(gap >= 0.0) || !(gap < nearest[i])) return;
+        nearest[i] = gap;
+        plane[i] = {i, nrm, point, velocity};
+    };
+    for (const Contact& c : mResting) {
+        const int v = c.pair.v[0];
+        // Hair on cloth: the hair meets the cloth in its own solve (World::clothAsColliders),
+        // and the cloth is not held against a strand.
+        if (!mBodyHasTriangles[mVertexBody[v]]) continue;
+        Vec3 q = Vec3::Zero(), vt = Vec3::Zero();
+        double mt = 0.0;
+        for (int k = 1; k < 4; ++k) {
+            const double w = -c.pair.a[k];
+            q += w * at(mX1, c.pair.v[k]);
+            vt += w * at(mV, c.pair.v[k]);
+            mt += w * mMass[c.pair.v[k]];
+        }
+        const double mv = mMass[v];
+        if (!(mv + mt > 0.0)) continue;
+        const Vec3 u = (mv * at(mV, v) + mt * vt) / (mv + mt);
+        offer(v, c.n, q, u);
+        for (int k = 1; k < 4; ++k)
+            if (-c.pair.a[k] > 0.3) offer(c.pair.v[k], -c.n, at(mX1, v), u);
+    }
+    std::vector<std::vector<ClothContactPlane>> out(mBodies.size());
+    for (size_t i = 0; i < n; ++i) {
+        if (!std::isfinite(nearest[i])) continue;
+        const int b = mVertexBody[i];
+        ClothContactPlane p = plane[i];
+        p.vertex = static_cast<int>(i) - mBodies[b].offset;
+        out[b].push_back(p);
+    }
+    return out;
 }
 
 std::vector<std::pair<std::array<int, 2>, std::array<int, 2>>>

@@ -60,6 +60,13 @@ public:
     // Precondition for the guarantee: the start positions have no crossings (pairs that start
     // touching or crossing are left as they are and counted in startTouching).
     SelfCollisionStats resolve(const std::vector<VecX>& start);
+    // Per body, the planes that hold its vertices against the cloth they rest on in the next
+    // step's solve (Body::setClothPlanes): from the last pass's vertex–triangle proximity pairs,
+    // at the positions and velocities it left. A vertex gets the plane of the triangle it is
+    // closest to along the pair's normal, and each corner carrying more than 0.3 of the closest
+    // point the mirrored plane through the vertex; pinned vertices none, nor pairs of a hair's
+    // vertex.
+    std::vector<std::vector<ClothContactPlane>> contactPlanes() const;
 
     // Intersecting triangle pairs at the bodies' current positions (contact/intersect.h): per
     // body, the pairs with at least one triangle of it.
@@ -149,6 +156,7 @@ private:
     bool mMaybeValid = false;
     std::vector<Pair> mLastHits; // of the last CCD round
     std::vector<Contact> mContacts; // proximity's pairs, or a CCD round's hits (reused buffer)
+    std::vector<Contact> mResting;  // the last proximity's vertex–triangle pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     bool mBuilt = false;
     long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild

@@ -1,8 +1,9 @@
 // Self- and cloth–cloth collision: the issue's falling sheet (which intersects itself without
 // it), a sheet thrown at another at one substep per frame (the tunnelling case), energy with no
 // wind, the impact-zone fail-safe on its own (momentum, no distance shrinking, no crossing on
-// the corrected path), results that do not depend on the threads, and a start that already
-// intersects (reported, kept from getting worse).
+// the corrected path), results that do not depend on the threads, a start that already
+// intersects (reported, kept from getting worse), and hair and cloth resting on cloth held in
+// their own solves.
 #include "solver/world/self_collision.h"
 
 #include "solver/bodies/cloth.h"
@@ -451,4 +452,56 @@ TEST_CASE("self-collision: hair as heavy as the cloth is left to the pass", "[so
     CHECK(heavy.crossings == 0);
     CHECK(heavy.allAbove);
     CHECK(heavy.sheetLowest < light.sheetLowest - 0.01);
+}
+
+TEST_CASE("self-collision: cloth resting on cloth is held in its own solve", "[solver][self]") {
+    // The issue's falling sheet (edge-first onto the ground, where it piles up on itself), with
+    // the resting pairs held in the solve (WorldSettings::clothContactInSolve) and with the pass
+    // alone: no intersection either way; held in the solve, the pass has fewer pairs to push in
+    // the resting pile (frames 25–49) and halves no more intervals, the solve holds cloth against
+    // cloth (contact constraints without any collider but the ground, counted above the
+    // ground's), and the resting pile's total energy does not grow by more than 1 % of the start.
+    struct Run {
+        long long pilePairs = 0, halvings = 0, constraints = 0;
+        int intersecting = 0;
+        double start = 0.0, at25 = 0.0, at49 = 0.0;
+    };
+    const auto run = [](bool inSolve) {
+        WorldSettings ws;
+        ws.clothContactInSolve = inSolve;
+        World w(ws);
+        w.setWind(constantWind(Vec3(0.5, 0.0, 0.3)));
+        w.addCollider(ground());
+        ClothMaterial m;
+        m.bend = gale::fields::Param(1e-4);
+        auto sheet =
+            std::make_unique<Cloth>("sheet", makeGrid(0.8, 0.8, 24, 24, Vec3(-0.4, 0.3, 0.0)), m);
+        sheet->collision().self = true;
+        w.addBody(std::move(sheet));
+        Run r;
+        const Body& b = *w.bodies()[0];
+        r.start = b.kineticEnergy() + b.potentialEnergy(ws.gravity);
+        for (int f = 2; f <= 49; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            const BodyFrameStats& s = fs.bodies[0];
+            const double e = s.kinetic + s.elastic + s.potential;
+            if (f == 25) r.at25 = e;
+            if (f == 49) r.at49 = e;
+            if (f >= 25) r.pilePairs += fs.selfContacts.proximityPairs;
+            r.halvings += fs.selfContacts.halvings;
+            r.constraints += s.contactConstraints;
+            r.intersecting += intersections({&b}) > 0;
+        }
+        return r;
+    };
+    const Run pass = run(false), solve = run(true);
+    CAPTURE(pass.pilePairs, solve.pilePairs, pass.halvings, solve.halvings, pass.constraints,
+            solve.constraints, solve.start, solve.at25, solve.at49);
+    CHECK(pass.intersecting == 0);
+    CHECK(solve.intersecting == 0);
+    CHECK(solve.pilePairs < pass.pilePairs);
+    CHECK(solve.halvings <= pass.halvings);
+    CHECK(solve.constraints > pass.constraints);
+    CHECK(solve.at49 - solve.at25 <= 0.01 * solve.start);
 }

@@ -180,6 +180,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 movedCloth = true;
                 body.forgetColliderBounds(); // the cloth's motion is new each interval
             }
+            if (k < mClothBodies && k < mClothPlanes.size()) body.setClothPlanes(mClothPlanes[k]);
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
@@ -220,6 +221,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                           tEnd, st.unresolved);
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
+        if (mSettings.clothContactInSolve) mClothPlanes = mSelf->contactPlanes();
         tick = end;
         // Grow back (WorldSettings::growBack), as stepBody does: two accepted passes at this
         // level and a boundary of the coarser one.

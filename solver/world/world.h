@@ -48,6 +48,11 @@ struct WorldSettings {
     // over the interval as a moving mesh collider, World::clothAsColliders), not only in the
     // self-collision pass after it. Off: the pass alone (measured against it).
     bool hairMeetsClothInSolve = true;
+    // Cloth resting on cloth is held in its own solve too: the self-collision pass's resting
+    // vertex–triangle pairs become sliding contact planes of the next interval's solves
+    // (SelfCollision::contactPlanes, Body::setClothPlanes), so that the pass after the solve
+    // has little left to push. Off: the pass alone (measured against it).
+    bool clothContactInSolve = true;
 };
 
 // Per body, per frame.
@@ -172,6 +177,8 @@ private:
     size_t mClothBodies = 0;
     std::vector<std::shared_ptr<MovingMeshContact>> mClothContacts;
     std::vector<std::vector<Collider>> mHairColliders;
+    // Per colliding body (mSelfBodies), the cloth contact planes of the last accepted pass.
+    std::vector<std::vector<ClothContactPlane>> mClothPlanes;
 };
 
 } // namespace gale::solver
