@@ -42,12 +42,9 @@ Collider ground() {
     return c;
 }
 
-// The issue's case: a 0.8 m sheet (24 × 24) dropped edge-first onto the ground in a light
-// breeze, 4 substeps per frame, 48 frames. Returns the frames with intersecting pairs.
-int fallingSheet(bool selfCollision, int threads, VecX* final = nullptr) {
-    WorldSettings ws;
-    ws.threads = threads;
-    World w(ws);
+// The issue's case: a 0.8 m sheet (24 × 24) about to drop edge-first onto the ground in a light
+// breeze, 4 substeps per frame.
+void addFallingSheet(World& w, bool selfCollision) {
     w.setWind(constantWind(Vec3(0.5, 0.0, 0.3)));
     w.addCollider(ground());
     ClothMaterial m;
@@ -56,6 +53,14 @@ int fallingSheet(bool selfCollision, int threads, VecX* final = nullptr) {
         std::make_unique<Cloth>("sheet", makeGrid(0.8, 0.8, 24, 24, Vec3(-0.4, 0.3, 0.0)), m);
     sheet->collision().self = selfCollision;
     w.addBody(std::move(sheet));
+}
+
+// The falling sheet over 48 frames. Returns the frames with intersecting pairs.
+int fallingSheet(bool selfCollision, int threads, VecX* final = nullptr) {
+    WorldSettings ws;
+    ws.threads = threads;
+    World w(ws);
+    addFallingSheet(w, selfCollision);
     int frames = 0;
     for (int f = 2; f <= 49; ++f) {
         const FrameStats fs = w.advanceFrame(f);
@@ -470,14 +475,7 @@ TEST_CASE("self-collision: cloth resting on cloth is held in its own solve", "[s
         WorldSettings ws;
         ws.clothContactInSolve = inSolve;
         World w(ws);
-        w.setWind(constantWind(Vec3(0.5, 0.0, 0.3)));
-        w.addCollider(ground());
-        ClothMaterial m;
-        m.bend = gale::fields::Param(1e-4);
-        auto sheet =
-            std::make_unique<Cloth>("sheet", makeGrid(0.8, 0.8, 24, 24, Vec3(-0.4, 0.3, 0.0)), m);
-        sheet->collision().self = true;
-        w.addBody(std::move(sheet));
+        addFallingSheet(w, true);
         Run r;
         const Body& b = *w.bodies()[0];
         r.start = b.kineticEnergy() + b.potentialEnergy(ws.gravity);
