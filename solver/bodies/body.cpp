@@ -550,9 +550,10 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                          SubstepStatus& st) {
     const size_t n = vertexCount();
     // Without colliders, cloth held against cloth (applyClothPlanes) is still released here.
-    const bool held = std::any_of(mContactCollider.begin(), mContactCollider.begin() + n,
-                                  [](int c) { return c >= 0; });
-    if ((!env.colliders || env.colliders->empty()) && !held) return 0;
+    if ((!env.colliders || env.colliders->empty()) &&
+        std::none_of(mContactCollider.begin(), mContactCollider.begin() + n,
+                     [](int c) { return c >= 0; }))
+        return 0;
     int changes = 0;
     mTmp.resize(3 * n);
     mA.multiply(mDv.data(), mTmp.data());

@@ -858,6 +858,8 @@ std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const
     // u = (m_v v_v + m_t v_t) / (m_v + m_t), as in an inelastic collision: v gets the plane
     // through q with the pair's normal n, the corners the plane through x_v with −n, both moving
     // at u. Of several planes a vertex keeps the one it is nearest (ties: the first pair).
+    std::vector<std::vector<ClothContactPlane>> out(mBodies.size());
+    if (mResting.empty()) return out; // most passes of a cape in the wind: no per-vertex scratch
     const size_t n = mVertexBody.size();
     std::vector<double> nearest(n, INFINITY);
     std::vector<ClothContactPlane> plane(n);
@@ -891,7 +893,6 @@ std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const
         for (int k = 1; k < 4; ++k)
             if (-c.pair.a[k] > 0.3) offer(c.pair.v[k], -c.n, at(mX1, v), u);
     }
-    std::vector<std::vector<ClothContactPlane>> out(mBodies.size());
     for (size_t i = 0; i < n; ++i) {
         if (!std::isfinite(nearest[i])) continue;
         const int b = mVertexBody[i];
