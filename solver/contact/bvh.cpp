@@ -12,6 +12,7 @@ constexpr int kLeafSize = 4;
 
 void Bvh::build(const std::vector<Box>& boxes) {
     mNodes.clear();
+    clearLabels();
     mOrder.resize(boxes.size());
     for (size_t i = 0; i < boxes.size(); ++i) mOrder[i] = static_cast<int>(i);
     std::vector<Eigen::Vector3d> centres(boxes.size());
@@ -37,11 +38,9 @@ int Bvh::buildRange(const std::vector<Box>& boxes, std::vector<Eigen::Vector3d>&
         cbox.add(centres[mOrder[i]]);
     }
     mNodes[id].box = box;
-    if (end - begin <= kLeafSize) {
-        mNodes[id].begin = begin;
-        mNodes[id].end = end;
-        return id;
-    }
+    mNodes[id].begin = begin;
+    mNodes[id].end = end;
+    if (end - begin <= kLeafSize) return id;
     int axis = 0;
     const Eigen::Vector3d ext = cbox.hi - cbox.lo;
     if (ext.y() > ext[axis]) axis = 1;
@@ -75,6 +74,26 @@ void Bvh::refitNodes() {
             b.add(mNodes[n.right].box);
         }
         n.box = b;
+    }
+}
+
+void Bvh::setLabels(const std::vector<int>& labelOfPrimitive) {
+    mLeafLabel.resize(mOrder.size());
+    for (std::size_t i = 0; i < mOrder.size(); ++i)
+        mLeafLabel[i] = labelOfPrimitive[static_cast<std::size_t>(mOrder[i])];
+    mNodeLabel.assign(mNodes.size(), -1);
+    for (std::size_t k = mNodes.size(); k-- > 0;) {
+        const Node& n = mNodes[k];
+        int label = -1;
+        if (n.left < 0) {
+            if (n.end > n.begin)
+                label = labelOfPrimitive[static_cast<std::size_t>(mOrder[n.begin])];
+            for (int i = n.begin + 1; i < n.end && label >= 0; ++i)
+                if (labelOfPrimitive[static_cast<std::size_t>(mOrder[i])] != label) label = -1;
+        } else if (mNodeLabel[n.left] == mNodeLabel[n.right]) {
+            label = mNodeLabel[n.left];
+        }
+        mNodeLabel[k] = label;
     }
 }
 

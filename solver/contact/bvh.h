@@ -152,6 +152,29 @@ public:
     std::size_t nodeCount() const { return mNodes.size(); }
     std::size_t primitiveCount() const { return mOrder.size(); }
     const Box& rootBox() const { return mNodes.front().box; }
+    // The tree's shape, for a caller that computes its own per-node bounds (parents before
+    // children, node 0 the root): children (−1 at a leaf) and the node's primitives,
+    // primitiveAt(begin) … primitiveAt(end − 1), a contiguous range for every node.
+    struct NodeView {
+        int left, right, begin, end;
+    };
+    NodeView node(int i) const {
+        const Node& n = mNodes[static_cast<std::size_t>(i)];
+        return {n.left, n.right, n.begin, n.end};
+    }
+    int primitiveAt(int i) const { return mOrder[static_cast<std::size_t>(i)]; }
+
+    // Labels that prune the pair walk: a pair of primitives of one label ≥ 0 (the same in both
+    // trees) is never reported, and a node pair whose primitives all carry that label is
+    // skipped with everything below it. A caller labels primitives
+    // whose pairs it has ruled out otherwise (a certified flat patch of cloth), −1 for the rest;
+    // the walk's other pairs and their order are unchanged. Cleared by build() and
+    // clearLabels(); query() and traverse() ignore them.
+    void setLabels(const std::vector<int>& labelOfPrimitive);
+    void clearLabels() {
+        mNodeLabel.clear();
+        mLeafLabel.clear();
+    }
 
 private:
     struct Node {
@@ -171,12 +194,18 @@ private:
     // Per primitive as last built or refitted, in leaf order: mLeafBoxes[i] is primitive
     // mOrder[i]'s (the pair tests of a leaf read them contiguously).
     std::vector<Box> mLeafBoxes;
+    std::vector<int> mNodeLabel; // per node: its primitives' common label, or −1; empty: none
+    std::vector<int> mLeafLabel; // per primitive in leaf order (as mLeafBoxes); empty: none
 };
 
 inline int Bvh::split(const Bvh& other, PairTask t, PairTask kids[3]) const {
     const Node& na = mNodes[t.a];
     const Node& nb = other.mNodes[t.b];
     if (!na.box.overlaps(nb.box)) return -1;
+    if (!mNodeLabel.empty() && !other.mNodeLabel.empty()) {
+        const int la = mNodeLabel[static_cast<std::size_t>(t.a)];
+        if (la >= 0 && la == other.mNodeLabel[static_cast<std::size_t>(t.b)]) return -1;
+    }
     const bool leafA = na.left < 0, leafB = nb.left < 0;
     if (&other == this && t.a == t.b) {
         if (leafA) return 0;
@@ -215,16 +244,23 @@ void Bvh::overlappingPairs(const Bvh& other, PairTask start, Fn&& fn) const {
         if (k < 0) continue;
         const Node& na = mNodes[t.a];
         const Node& nb = other.mNodes[t.b];
+        // Two primitives of one label ≥ 0 are skipped here too (leaves with mixed labels).
+        const bool labels = !mLeafLabel.empty() && !other.mLeafLabel.empty();
+        const auto sameLabel = [&](int i, int j) {
+            return labels && mLeafLabel[i] >= 0 && mLeafLabel[i] == other.mLeafLabel[j];
+        };
         if (self && t.a == t.b) {
             for (int i = na.begin; i < na.end; ++i)
                 for (int j = i + 1; j < na.end; ++j)
-                    if (mLeafBoxes[i].overlaps(mLeafBoxes[j])) fn(mOrder[i], mOrder[j]);
+                    if (mLeafBoxes[i].overlaps(mLeafBoxes[j]) && !sameLabel(i, j))
+                        fn(mOrder[i], mOrder[j]);
             continue;
         }
         for (int i = na.begin; i < na.end; ++i) {
             const Box& bi = mLeafBoxes[i];
             for (int j = nb.begin; j < nb.end; ++j)
-                if (bi.overlaps(other.mLeafBoxes[j])) fn(mOrder[i], other.mOrder[j]);
+                if (bi.overlaps(other.mLeafBoxes[j]) && !sameLabel(i, j))
+                    fn(mOrder[i], other.mOrder[j]);
         }
     }
 }

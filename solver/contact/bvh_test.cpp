@@ -243,3 +243,51 @@ TEST_CASE("bvh: the nearest-first walk finds the lowest (distance, index) of bru
     b.add(Eigen::Vector3d(0.5, 0.5, 0.5));
     CHECK(a.distance2(b) == 0.0); // overlapping
 }
+
+TEST_CASE("bvh: labels prune exactly the pairs of one label, the rest in the walk's order",
+          "[contact][bvh]") {
+    // Boxes along a strip, labelled in runs (−1 between): the labelled walk gives the plain
+    // walk's pairs with those of two equal labels ≥ 0 filtered out, in the same order; pairs of
+    // −1 or of different labels stay.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    const int n = 3000;
+    std::vector<Box> boxes(n);
+    std::vector<int> label(n);
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d c(i / double(n), 0.02 * U(rng), 0.02 * U(rng));
+        boxes[i].add(c);
+        boxes[i].add(c + Eigen::Vector3d(0.003 * U(rng), 0.01, 0.01));
+        label[i] = (i / 200) % 3 == 2 ? -1 : i / 200;
+    }
+    Bvh tree, other;
+    tree.build(boxes);
+    other.build(randomBoxes(rng, 800, 0.02));
+    std::vector<std::pair<int, int>> whole, pruned;
+    tree.overlappingPairs(tree, [&](int i, int j) { whole.emplace_back(i, j); });
+    tree.setLabels(label);
+    tree.overlappingPairs(tree, [&](int i, int j) { pruned.emplace_back(i, j); });
+    std::vector<std::pair<int, int>> want;
+    for (const auto& [i, j] : whole)
+        if (!(label[i] >= 0 && label[i] == label[j])) want.push_back({i, j});
+    REQUIRE(want.size() < whole.size() / 2); // the labels do cover most pairs
+    REQUIRE(want.size() > 100);
+    CHECK(pruned.size() == want.size());
+    CHECK(pruned == want);
+    // The tasks of a labelled walk give its pairs too.
+    std::vector<std::pair<int, int>> split;
+    for (const auto& t : tree.pairTasks(tree, 16))
+        tree.overlappingPairs(tree, t, [&](int i, int j) { split.emplace_back(i, j); });
+    CHECK(split == want);
+    // Against an unlabelled tree nothing is pruned; clearLabels and build drop the labels.
+    std::vector<std::pair<int, int>> mixed, plain;
+    tree.overlappingPairs(other, [&](int i, int j) { mixed.emplace_back(i, j); });
+    tree.clearLabels();
+    tree.overlappingPairs(other, [&](int i, int j) { plain.emplace_back(i, j); });
+    CHECK(mixed == plain);
+    std::vector<std::pair<int, int>> again;
+    tree.setLabels(label);
+    tree.build(boxes);
+    tree.overlappingPairs(tree, [&](int i, int j) { again.emplace_back(i, j); });
+    CHECK(again == whole);
+}

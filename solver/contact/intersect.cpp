@@ -85,27 +85,30 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
         for (int k = 0; k < 3; ++k) boxes[i].add(at(triangles[i][k]));
     Bvh tree;
     tree.build(boxes);
-    for (size_t i = 0; i < triangles.size(); ++i) {
-        const auto& ti = triangles[i];
-        const Vec3 t[3] = {at(ti[0]), at(ti[1]), at(ti[2])};
-        tree.query(boxes[i], [&](int j) {
-            if (j <= static_cast<int>(i) || (limit > 0 && pairs.size() >= limit)) return;
-            const auto& tj = triangles[j];
-            int shared = 0, sT = -1, sU = -1;
-            for (int a = 0; a < 3; ++a)
-                for (int b = 0; b < 3; ++b)
-                    if (ti[a] == tj[b]) {
-                        ++shared;
-                        sT = a;
-                        sU = b;
-                    }
-            if (shared >= 2) return;
-            const Vec3 u[3] = {at(tj[0]), at(tj[1]), at(tj[2])};
-            const bool hit = shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU)
-                                         : trianglesIntersect(t, u);
-            if (hit) pairs.emplace_back(static_cast<int>(i), j);
-        });
+    // The pairs whose boxes overlap, by one walk of the tree against itself (cheaper than a
+    // query per triangle), in (i, j) order.
+    std::vector<std::pair<int, int>> candidates;
+    tree.overlappingPairs(
+        tree, [&](int a, int b) { candidates.emplace_back(std::min(a, b), std::max(a, b)); });
+    std::sort(candidates.begin(), candidates.end());
+    for (const auto& [i, j] : candidates) {
         if (limit > 0 && pairs.size() >= limit) break;
+        const auto& ti = triangles[i];
+        const auto& tj = triangles[j];
+        int shared = 0, sT = -1, sU = -1;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                if (ti[a] == tj[b]) {
+                    ++shared;
+                    sT = a;
+                    sU = b;
+                }
+        if (shared >= 2) continue;
+        const Vec3 t[3] = {at(ti[0]), at(ti[1]), at(ti[2])};
+        const Vec3 u[3] = {at(tj[0]), at(tj[1]), at(tj[2])};
+        const bool hit =
+            shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU) : trianglesIntersect(t, u);
+        if (hit) pairs.emplace_back(i, j);
     }
     return pairs;
 }

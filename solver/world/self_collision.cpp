@@ -39,7 +39,6 @@ using contact::Box;
 namespace {
 constexpr double kTouching = 1e-9; // m: pairs this close at x₀ have no side to keep
 constexpr int kChunk = 64;         // primitives per parallel chunk (results ordered by chunk)
-constexpr int kRebuildEvery = 8;   // passes between tree rebuilds (refits in between)
 // Candidates stay valid while no vertex moves more than this × ξ from where they were gathered.
 constexpr double kMoveAllowance = 0.5;
 // A re-gather queries only the moved vertices' primitives while at most 1/kRegatherShare of the
@@ -52,6 +51,11 @@ constexpr double kBoundMargin = 1e-6;
 constexpr double kEase = 0.25;
 // The inverse-mass factor of vertices touching a collider (gather()).
 constexpr double kHeldByCollider = 0.01;
+// The slack (× ξ) a flat patch's vertices may stray from the path it was certified for: a
+// larger one lets corrections move further before the patch is certified again, but widens
+// every triangle's normal cone, so a curved sheet breaks into more, smaller patches (the cape
+// benchmark: ξ/8 left 12.3M candidates, ξ/4 14.1–15.0M, ξ/2 23.5M, against 27.8M without).
+constexpr double kFlatSlack = 0.125;
 
 double seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -124,6 +128,7 @@ void SelfCollision::addBody(Body& body, const std::vector<std::array<int, 3>>& t
         mAdjacency.insert(mAdjacency.end(), r.begin(), r.end());
         mAdjacencyStart.push_back(static_cast<int>(mAdjacency.size()));
     }
+    mFlat.setTopology(mTris, mVertexBody.size(), std::vector<uint8_t>(mTris.size(), 1));
     mBuilt = false;
     mCandidatesValid = false;
 }
@@ -190,17 +195,29 @@ void SelfCollision::refitBoxes(const std::vector<double>& lo, const std::vector<
                       [&](size_t i) { mTriBoxes[i] = boxOf(mTris[i].data(), 3); });
     tbb::parallel_for(size_t(0), mEdges.size(),
                       [&](size_t i) { mEdgeBoxes[i] = boxOf(mEdges[i].data(), 2); });
-    if (!mBuilt || (mPasses % kRebuildEvery == 0 && mBuiltPass != mPasses)) {
-        tbb::parallel_invoke([&] { mVertTree.build(mVertBoxes); },
-                             [&] { mTriTree.build(mTriBoxes); },
-                             [&] { mEdgeTree.build(mEdgeBoxes); });
+    // The trees are built once over the rest shape and refitted from then on: their nodes are
+    // compact pieces of the cloth as cut (flat patches are such nodes, and a refit keeps them),
+    // whatever it folds into; a rebuild over the moving boxes cut patches along the folds.
+    if (!mBuilt) {
+        const auto restBox = [&](const int* v, int count) {
+            Box b;
+            for (int k = 0; k < count; ++k) b.add(Vec3(vec3At(mRest.data(), v[k])));
+            return b;
+        };
+        std::vector<Box> vert(mVertBoxes.size()), tri(mTris.size()), edge(mEdges.size());
+        for (size_t i = 0; i < vert.size(); ++i) {
+            const int v = static_cast<int>(i);
+            vert[i] = restBox(&v, 1);
+        }
+        for (size_t i = 0; i < tri.size(); ++i) tri[i] = restBox(mTris[i].data(), 3);
+        for (size_t i = 0; i < edge.size(); ++i) edge[i] = restBox(mEdges[i].data(), 2);
+        tbb::parallel_invoke([&] { mVertTree.build(vert); }, [&] { mTriTree.build(tri); },
+                             [&] { mEdgeTree.build(edge); });
         mBuilt = true;
-        mBuiltPass = mPasses;
-    } else {
-        mVertTree.refit(mVertBoxes);
-        mTriTree.refit(mTriBoxes);
-        mEdgeTree.refit(mEdgeBoxes);
     }
+    mVertTree.refit(mVertBoxes);
+    mTriTree.refit(mTriBoxes);
+    mEdgeTree.refit(mEdgeBoxes);
 }
 
 double SelfCollision::pairThickness(const Pair& p) const {
@@ -411,17 +428,49 @@ bool SelfCollision::ensureCandidates() {
     const size_t n = mX1.size() / 3;
     if (mCandidatesValid) {
         std::vector<uint8_t> moved(n, 0);
-        size_t count = 0;
         for (size_t i = 0; i < n; ++i)
             for (int j = 0; j < 3; ++j) {
                 const double lo = mRegionLo[3 * i + j], hi = mRegionHi[3 * i + j];
                 const double a = mX0[3 * i + j], b = mX1[3 * i + j];
                 if (!(a >= lo && a <= hi && b >= lo && b <= hi)) {
                     moved[i] = 1;
-                    ++count;
                     break;
                 }
             }
+        // A vertex of a flat patch may stray δ from either end of the path its patch was
+        // certified for. Beyond, the pairs its position vouched for are queried again: those of
+        // every vertex whose fan it is in (a left-out pair rests on its vertices' fans).
+        if (!mInPatch.empty()) {
+            const double slack = flatSlack();
+            std::vector<uint8_t> strayed(n, 0);
+            bool any = false;
+            for (size_t i = 0; i < n; ++i) {
+                if (!mInPatch[i]) continue;
+                const double d0 = (vec3At(mX0.data(), i) - vec3At(mCertX0.data(), i)).squaredNorm();
+                const double d1 = (vec3At(mX1.data(), i) - vec3At(mCertX1.data(), i)).squaredNorm();
+                if (moved[i] || !(d0 <= slack * slack) || !(d1 <= slack * slack)) {
+                    strayed[i] = 1;
+                    any = true;
+                }
+            }
+            // The patches certified again for this path (a pile creeping, CCD moving a few
+            // vertices) keep their pairs left out; the fans of the vertices of those that fail
+            // (or of the strayed vertices, when many left their regions anyway) are queried
+            // again.
+            if (any) {
+                const size_t left = static_cast<size_t>(std::count(moved.begin(), moved.end(), 1));
+                std::vector<uint8_t> lost(n, 0);
+                if (left * kRegatherShare <= n) {
+                    mFlat.recertify(mX0, mX1, slack, mMaxThickness, lost);
+                    mCertX0 = mX0;
+                    mCertX1 = mX1;
+                } else {
+                    lost.swap(strayed);
+                }
+                mFlat.markFans(lost, moved);
+            }
+        }
+        const size_t count = static_cast<size_t>(std::count(moved.begin(), moved.end(), 1));
         if (count == 0) return false;
         // A CCD correction moves the few vertices of the pairs it hit, a resting pile only its
         // few sliding vertices: re-query only those (the pairs of the others are still
@@ -441,6 +490,7 @@ bool SelfCollision::ensureCandidates() {
     mRegionHi.resize(3 * n);
     for (size_t i = 0; i < n; ++i) setRegion(i, delta);
     refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
+    labelFlatPatches(flatSlack());
     gatherCandidates(mCandVt, mCandEe);
     mCandidatesValid = true;
     mMaybeValid = false;
@@ -448,6 +498,34 @@ bool SelfCollision::ensureCandidates() {
     mStats.candidates += static_cast<long long>(mCandVt.size() + mCandEe.size());
     mStats.broadSeconds += seconds(t0);
     return true;
+}
+
+double SelfCollision::flatSlack() const {
+    return kFlatSlack * mMaxThickness;
+}
+
+void SelfCollision::labelFlatPatches(double slack) {
+    mInPatch.clear();
+    const int patches =
+        mSettings.flatPatches ? mFlat.find(mTriTree, mX0, mX1, slack, mMaxThickness) : 0;
+    if (patches == 0) {
+        mVertTree.clearLabels();
+        mTriTree.clearLabels();
+        mEdgeTree.clearLabels();
+        return;
+    }
+    const std::vector<int>& vertex = mFlat.vertexLabels();
+    std::vector<int> edge(mEdges.size());
+    for (size_t e = 0; e < mEdges.size(); ++e) {
+        const int a = vertex[mEdges[e][0]];
+        edge[e] = a == vertex[mEdges[e][1]] ? a : -1;
+    }
+    mVertTree.setLabels(vertex);
+    mTriTree.setLabels(mFlat.triangleLabels());
+    mEdgeTree.setLabels(edge);
+    mInPatch = mFlat.inPatch();
+    mCertX0 = mX0;
+    mCertX1 = mX1;
 }
 
 void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
@@ -460,6 +538,10 @@ void SelfCollision::regatherMoved(const std::vector<uint8_t>& moved) {
     for (size_t i = 0; i < n; ++i)
         if (moved[i]) setRegion(i, kMoveAllowance * mMaxThickness);
     refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
+    // Every pair of a moved vertex is found below: none rests on its certificate any more.
+    if (!mInPatch.empty())
+        for (size_t i = 0; i < n; ++i)
+            if (moved[i]) mInPatch[i] = 0;
     const auto touches = [&](const Candidate& c) {
         return moved[c[0]] || moved[c[1]] || moved[c[2]] || moved[c[3]];
     };
@@ -847,7 +929,6 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
     }
     if (!clear && ccdRound(false, &hits, nullptr, &dirty) > 0) impactZones(hits);
     mStats.passes = 1;
-    ++mPasses;
     scatter();
     return mStats;
 }

@@ -7,6 +7,7 @@
 
 #include "solver/bodies/body.h"
 #include "solver/contact/bvh.h"
+#include "solver/world/flat_patches.h"
 
 #include <array>
 #include <utility>
@@ -40,6 +41,9 @@ struct SelfCollisionSettings {
     int proximityIterations = 3; // Gauss–Seidel sweeps over the proximity pairs
     int ccdRounds = 6;           // CCD detect-and-correct rounds before the impact zones
     int zoneRounds = 64;         // impact-zone rounds before the last resort (hold at x₀)
+    // The broad phase skips pairs inside certified flat patches of cloth (flat_patches.h): the
+    // same pairs are corrected either way, found with less work.
+    bool flatPatches = true;
 };
 
 class SelfCollision {
@@ -110,6 +114,10 @@ private:
     // The candidates again after the vertices marked in `moved` (and only they) moved beyond
     // the allowance: the pairs of unmoved vertices kept, those with a moved one queried anew.
     void regatherMoved(const std::vector<uint8_t>& moved);
+    // After a full gathering's refit: the flat patches of the step (slack δ), as labels that
+    // prune the trees' pair walks, and the positions they were certified at.
+    void labelFlatPatches(double slack);
+    double flatSlack() const;
     bool restClose(const Pair& p, bool vertexTriangle) const;
     bool adjacent(int a, int b) const;
     bool neighbours(const Pair& p, bool vertexTriangle) const;
@@ -158,8 +166,13 @@ private:
     std::vector<Contact> mContacts; // proximity's pairs, or a CCD round's hits (reused buffer)
     std::vector<Contact> mResting;  // the last proximity's vertex–triangle pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
-    bool mBuilt = false;
-    long long mPasses = 0, mBuiltPass = -1; // passes resolved; the pass of the last rebuild
+    // Flat patches of the last full gathering: the pairs inside them are left out of the
+    // candidates while every vertex of a patch stays within δ of both ends of the path they were
+    // certified for (mCertX0 → mCertX1); mInPatch marks the vertices still relied on.
+    FlatPatches mFlat;
+    std::vector<double> mCertX0, mCertX1;
+    std::vector<uint8_t> mInPatch;
+    bool mBuilt = false; // the trees (built once, over the rest shape)
     double mMaxThickness = 0.0;
     SelfCollisionStats mStats; // of the pass under way
 };
