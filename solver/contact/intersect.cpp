@@ -86,30 +86,27 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
     Bvh tree;
     tree.build(boxes);
     // The pairs whose boxes overlap, by one walk of the tree against itself (cheaper than a
-    // query per triangle), in (i, j) order.
-    std::vector<std::pair<int, int>> candidates;
-    tree.overlappingPairs(
-        tree, [&](int a, int b) { candidates.emplace_back(std::min(a, b), std::max(a, b)); });
-    std::sort(candidates.begin(), candidates.end());
-    for (const auto& [i, j] : candidates) {
-        if (limit > 0 && pairs.size() >= limit) break;
+    // query per triangle), in the walk's order.
+    tree.overlappingPairs(tree, [&](int a, int b) {
+        if (limit > 0 && pairs.size() >= limit) return;
+        const int i = std::min(a, b), j = std::max(a, b);
         const auto& ti = triangles[i];
         const auto& tj = triangles[j];
         int shared = 0, sT = -1, sU = -1;
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
-                if (ti[a] == tj[b]) {
+        for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q)
+                if (ti[p] == tj[q]) {
                     ++shared;
-                    sT = a;
-                    sU = b;
+                    sT = p;
+                    sU = q;
                 }
-        if (shared >= 2) continue;
+        if (shared >= 2) return;
         const Vec3 t[3] = {at(ti[0]), at(ti[1]), at(ti[2])};
         const Vec3 u[3] = {at(tj[0]), at(tj[1]), at(tj[2])};
-        const bool hit =
-            shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU) : trianglesIntersect(t, u);
+        const bool hit = shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU)
+                                     : trianglesIntersect(t, u);
         if (hit) pairs.emplace_back(i, j);
-    }
+    });
     return pairs;
 }
 

@@ -35,7 +35,8 @@ bool trianglesSharingVertexIntersect(const Vec3 t[3], int sharedT, const Vec3 u[
 
 // The intersecting pairs (i < j) among `triangles` over vertex positions `x` (3 per vertex):
 // pairs sharing no vertex by trianglesIntersect, pairs sharing one by the fan test; pairs
-// sharing an edge are never counted. In (i, j) order; `limit` > 0 stops after that many pairs.
+// sharing an edge are never counted. In the tree walk's order (deterministic); `limit` > 0
+// stops after that many pairs.
 std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
                                                    const std::vector<std::array<int, 3>>& triangles,
                                                    size_t limit = 0);
