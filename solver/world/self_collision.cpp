@@ -197,7 +197,8 @@ void SelfCollision::refitBoxes(const std::vector<double>& lo, const std::vector<
                       [&](size_t i) { mEdgeBoxes[i] = boxOf(mEdges[i].data(), 2); });
     // The trees are built once over the rest shape and refitted from then on: their nodes are
     // compact pieces of the cloth as cut (flat patches are such nodes, and a refit keeps them),
-    // whatever it folds into; a rebuild over the moving boxes cut patches along the folds.
+    // whatever it folds into (a rebuild over the moving boxes cut nodes across the folds, and
+    // their contours were rarely star-shaped: 21.7M candidates on the cape against 13.0M).
     if (!mBuilt) {
         const auto restBox = [&](const int* v, int count) {
             Box b;

@@ -98,7 +98,7 @@ private:
     void gather();
     void scatter();
     // Boxes of the primitives over their vertices' boxes [lo, hi] (3 per vertex each),
-    // inflated; the trees refitted (or rebuilt).
+    // inflated; the trees refitted (built over the rest shape the first time).
     void refitBoxes(const std::vector<double>& lo, const std::vector<double>& hi, double inflate);
     // Vertex i's region: the box of x₀ → x₁ grown by delta.
     void setRegion(size_t i, double delta);
