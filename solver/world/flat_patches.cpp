@@ -238,7 +238,7 @@ int FlatPatches::find(const contact::Bvh& triTree, const std::vector<double>& x0
 
 std::size_t FlatPatches::recertify(const std::vector<double>& x0, const std::vector<double>& x1,
                                    double slack, double thickness, std::vector<uint8_t>& lost) {
-    std::vector<int> members;
+    std::vector<int> members, keptStart{0}, keptTris;
     std::vector<Cone> cones;
     std::size_t failed = 0;
     for (std::size_t p = 0; p + 1 < mPatchStart.size(); ++p) {
@@ -257,12 +257,18 @@ std::size_t FlatPatches::recertify(const std::vector<double>& x0, const std::vec
                 merge(cones[i], cones[i + width]);
         const Cone& cone = cones.front();
         if (cone.angle < kHalfPi && std::cos(cone.angle) * cone.height >= kClearance * thickness &&
-            starContour(members, stamp, cone.axis, x0, x1, slack))
+            starContour(members, stamp, cone.axis, x0, x1, slack)) {
+            keptTris.insert(keptTris.end(), members.begin(), members.end());
+            keptStart.push_back(static_cast<int>(keptTris.size()));
             continue;
+        }
+        // Lost for good: its pairs are found another way from now on, so it is not tried again.
         ++failed;
         for (int t : members)
             for (int v : mTris[static_cast<std::size_t>(t)]) lost[static_cast<std::size_t>(v)] = 1;
     }
+    mPatchStart.swap(keptStart);
+    mPatchTris.swap(keptTris);
     return failed;
 }
 

@@ -39,7 +39,8 @@ public:
 
     // The same patches (the triangles of the last find()) for another step: each that passes the
     // test again keeps its labels for that step; the corners of each that does not are flagged in
-    // `lost` (its pairs must be found another way). Returns how many did not.
+    // `lost` (its pairs must be found another way) and it is dropped (not tried again until the
+    // next find()). Returns how many did not pass.
     std::size_t recertify(const std::vector<double>& x0, const std::vector<double>& x1,
                           double slack, double thickness, std::vector<uint8_t>& lost);
 

@@ -175,6 +175,10 @@ TEST_CASE("flat patches: a sheet turning and moving is one patch, its pairs more
     CHECK(std::count(lost.begin(), lost.end(), 1) == 0);
     CHECK(fp.recertify(x1, folded, slack, xi, lost) == 1);
     CHECK(static_cast<size_t>(std::count(lost.begin(), lost.end(), 1)) == s.x.size() / 3);
+    // Lost, it is not tried again: nothing passes, nothing fails.
+    std::fill(lost.begin(), lost.end(), 0);
+    CHECK(fp.recertify(x1, x2, slack, xi, lost) == 0);
+    CHECK(std::count(lost.begin(), lost.end(), 1) == 0);
 }
 
 TEST_CASE("flat patches: a sheet squeezed below ξ leaves out no pair that comes within ξ",
