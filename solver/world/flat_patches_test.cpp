@@ -133,6 +133,15 @@ FlatPatches patchesOf(const Sheet& rest) {
     return fp;
 }
 
+// The patches of the step x0 → x1 over `rest`'s mesh and tree, judged: returns the verdict and
+// the patch count.
+std::pair<Verdict, int> certifyAndJudge(const Sheet& rest, const std::vector<double>& x0,
+                                        const std::vector<double>& x1, double slack, double xi) {
+    FlatPatches fp = patchesOf(rest);
+    const int patches = fp.find(restTree(rest), x0, x1, slack, xi);
+    return {judge(fp, rest.tris, x0, x1, slack, xi), patches};
+}
+
 size_t labelled(const std::vector<int>& labels) {
     return static_cast<size_t>(
         std::count_if(labels.begin(), labels.end(), [](int l) { return l >= 0; }));
@@ -190,9 +199,8 @@ TEST_CASE("flat patches: a sheet squeezed below ξ leaves out no pair that comes
     const Sheet end = grid(12, 16, [](int i, int j) {
         return Vec3(0.01 * i, j < 8 ? 0.01 * j : 0.07 + 0.0012 * (j - 7), 0.0);
     });
-    FlatPatches fp = patchesOf(s);
-    CHECK(fp.find(restTree(s), s.x, end.x, slack, xi) >= 1);
-    const Verdict v = judge(fp, s.tris, s.x, end.x, slack, xi);
+    const auto [v, patches] = certifyAndJudge(s, s.x, end.x, slack, xi);
+    CHECK(patches >= 1);
     CHECK(v.close > 100);
     CHECK(v.leftOut > 1000); // the lower half's pairs
     CHECK(v.leftOutMin > xi);
@@ -213,9 +221,7 @@ TEST_CASE("flat patches: a sheet folded onto itself keeps its facing layers' pai
         return Vec3(half + radius * std::sin(turn) - beyond, 0.01 * j,
                     radius * (1.0 - std::cos(turn)));
     });
-    FlatPatches fp = patchesOf(rest);
-    const int patches = fp.find(restTree(rest), folded.x, folded.x, slack, xi);
-    const Verdict v = judge(fp, rest.tris, folded.x, folded.x, slack, xi);
+    const auto [v, patches] = certifyAndJudge(rest, folded.x, folded.x, slack, xi);
     CHECK(v.close > 100);
     CHECK(patches >= 2); // each layer's flat part is a patch of its own
     CHECK(v.leftOut > 1000);
@@ -234,9 +240,7 @@ TEST_CASE("flat patches: the turns of a spiral ramp ξ/2 apart are told apart by
         const double r = 0.06 + 0.02 * i, a = 1.6 * 2.0 * M_PI * j / (nt - 1);
         return Vec3(r * std::cos(a), r * std::sin(a), 0.0015 * a / (2.0 * M_PI));
     });
-    FlatPatches fp = patchesOf(ramp);
-    const int patches = fp.find(restTree(ramp), ramp.x, ramp.x, slack, xi);
-    const Verdict v = judge(fp, ramp.tris, ramp.x, ramp.x, slack, xi);
+    const auto [v, patches] = certifyAndJudge(ramp, ramp.x, ramp.x, slack, xi);
     CHECK(patches >= 2);
     CHECK(v.close > 500);
     CHECK(v.leftOut > 1000);
@@ -252,9 +256,8 @@ TEST_CASE("flat patches: triangles narrower than ξ are left to the pair walk",
     const Sheet s = grid(16, 8, [](int i, int j) {
         return Vec3(i < 8 ? 0.02 * i : 0.14 + 0.007 * (i - 7), 0.02 * j, 0.0);
     });
-    FlatPatches fp = patchesOf(s);
-    CHECK(fp.find(restTree(s), s.x, s.x, slack, xi) >= 1);
-    const Verdict v = judge(fp, s.tris, s.x, s.x, slack, xi);
+    const auto [v, patches] = certifyAndJudge(s, s.x, s.x, slack, xi);
+    CHECK(patches >= 1);
     CHECK(v.close > 50);
     CHECK(v.leftOut > 100); // the left half's pairs
     CHECK(v.leftOutMin > xi);
