@@ -1298,8 +1298,11 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         }
         syncFriction(v0, false); // A as assembled again (Newton, the next rounds' callers)
     }
-    for (size_t i = 0; i < n; ++i)
+    const int clothIndex = static_cast<int>(mKin.colliders.size()); // applyClothPlanes
+    for (size_t i = 0; i < n; ++i) {
         if (mContactCollider[i] >= 0) ++st.contactConstraints;
+        if (mContactCollider[i] == clothIndex) ++st.clothConstraints;
+    }
     st.iterations = ls.iterations;
     st.residual = ls.residual;
     st.converged = ls.converged && !ls.failed;

@@ -157,6 +157,7 @@ struct SubstepStatus {
     // projection after the solve still had to do: vertices it moved or stopped, the largest
     // push-out (m) and the largest approach speed it removed (m/s).
     int contactConstraints = 0, contactAdded = 0, contactReleases = 0, contactSolves = 0;
+    int clothConstraints = 0; // of contactConstraints: cloth held against cloth (setClothPlanes)
     int contactSlides = 0; // sticking contacts that turned to slide (friction at μ λ_n)
     int projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;

@@ -394,6 +394,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         tick += ticksPerBase >> level;
         stats.contacts = st.contacts;
         stats.contactConstraints += st.contactConstraints;
+        stats.clothConstraints += st.clothConstraints;
         stats.contactAdded += st.contactAdded;
         stats.contactReleases += st.contactReleases;
         stats.contactSlides += st.contactSlides;

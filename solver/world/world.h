@@ -83,6 +83,7 @@ struct BodyFrameStats {
     // after the solve: vertices it still moved or stopped, its largest push-out (m) and the
     // largest approach speed it removed (m/s).
     long contactConstraints = 0;
+    long clothConstraints = 0; // of contactConstraints: cloth held against cloth in the solve
     int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
         projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
