@@ -187,7 +187,7 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"proximity_pairs\": " << s.proximityPairs << ", \"ccd_hits\": " << s.ccdHits
           << ", \"ccd_rounds\": " << s.ccdRounds << ", \"broad_phases\": " << s.broadPhases
           << ", \"candidates\": " << s.candidates << ", \"fail_safe_runs\": " << s.failSafeRuns
-          << ", \"halvings\": " << s.halvings
+          << ", \"halvings\": " << s.halvings << ", \"retries\": " << s.retries
           << ", \"zone_vertices\": " << s.zoneVertices
           << ", \"frozen_vertices\": " << s.frozenVertices << ", \"unresolved\": " << s.unresolved
           << ", \"start_touching\": " << s.startTouching

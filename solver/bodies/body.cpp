@@ -461,7 +461,7 @@ void Body::applyClothPlanes(double t, double h) {
         const Vec3 v0 = vec3At(mV.data(), i);
         const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - plane.velocity;
         const double un = pred.dot(plane.normal);
-        if (!(un < 0.0)) continue;
+        if (!(un < 0.0) && !plane.closing) continue;
         ContactPoint cp;
         cp.normal = plane.normal;
         cp.distance = plane.normal.dot(x - plane.point);
@@ -469,7 +469,7 @@ void Body::applyClothPlanes(double t, double h) {
         cp.velocity = plane.velocity;
         setContact(i, index, cp, x, t, std::min(cp.distance, xi), t + h, h, mX, mV, v0, false);
         mContactMu[i] = 0.0;
-        mContactImpulse[i] = -un;
+        mContactImpulse[i] = std::max(0.0, -un);
     }
     mClothPlanes.clear();
 }

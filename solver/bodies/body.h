@@ -224,6 +224,9 @@ struct ClothContactPlane {
     Vec3 normal;     // unit, from the other cloth towards the vertex
     Vec3 point;      // m: the other cloth's closest point at the step's start
     Vec3 velocity;   // m/s: the pair's centre-of-mass velocity (an inelastic meeting)
+    // The pass after this very step found the pair closing (a retry, World): held whatever the
+    // explicit prediction says (it missed the approach once).
+    bool closing = false;
 };
 
 class Body {

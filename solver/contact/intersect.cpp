@@ -4,6 +4,8 @@
 
 #include "solver/contact/bvh.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -45,20 +47,38 @@ int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
     return 0;
 }
 
+namespace {
+// Whether the line through p and q passes through the closed triangle abc: the triangle's edges
+// wind the same way round it (a segment whose ends lie on different sides of the plane then
+// crosses the triangle).
+bool lineThroughTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
+                         const Vec3& c) {
+    const int o1 = orient3d(p, q, a, b), o2 = orient3d(p, q, b, c), o3 = orient3d(p, q, c, a);
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+} // namespace
+
 bool segmentCrossesTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
                             const Vec3& c) {
     const int sp = orient3d(a, b, c, p), sq = orient3d(a, b, c, q);
     if (sp == sq) return false; // same side, or both in the plane (coplanar: not counted)
-    const int o1 = orient3d(p, q, a, b), o2 = orient3d(p, q, b, c), o3 = orient3d(p, q, c, a);
-    const bool nonNeg = o1 >= 0 && o2 >= 0 && o3 >= 0;
-    const bool nonPos = o1 <= 0 && o2 <= 0 && o3 <= 0;
-    return nonNeg || nonPos;
+    return lineThroughTriangle(p, q, a, b, c);
 }
 
 bool trianglesIntersect(const Vec3 t[3], const Vec3 u[3]) {
+    // Each corner's side of the other's plane, once (segmentCrossesTriangle would take each
+    // twice). A triangle strictly on one side of the other's plane touches neither it nor, then,
+    // the other triangle (Möller's rejection); coplanar ones count as not intersecting.
+    int st[3], su[3];
+    for (int k = 0; k < 3; ++k) st[k] = orient3d(u[0], u[1], u[2], t[k]);
+    if (st[0] == st[1] && st[1] == st[2]) return false;
+    for (int k = 0; k < 3; ++k) su[k] = orient3d(t[0], t[1], t[2], u[k]);
+    if (su[0] == su[1] && su[1] == su[2]) return false;
+    // Then, as segmentCrossesTriangle, each edge whose ends are on different sides.
     for (int e = 0; e < 3; ++e) {
-        if (segmentCrossesTriangle(t[e], t[(e + 1) % 3], u[0], u[1], u[2])) return true;
-        if (segmentCrossesTriangle(u[e], u[(e + 1) % 3], t[0], t[1], t[2])) return true;
+        const int f = (e + 1) % 3;
+        if (st[e] != st[f] && lineThroughTriangle(t[e], t[f], u[0], u[1], u[2])) return true;
+        if (su[e] != su[f] && lineThroughTriangle(u[e], u[f], t[0], t[1], t[2])) return true;
     }
     return false;
 }
@@ -86,27 +106,37 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
     Bvh tree;
     tree.build(boxes);
     // The pairs whose boxes overlap, by one walk of the tree against itself (cheaper than a
-    // query per triangle), in the walk's order.
-    tree.overlappingPairs(tree, [&](int a, int b) {
-        if (limit > 0 && pairs.size() >= limit) return;
-        const int i = std::min(a, b), j = std::max(a, b);
-        const auto& ti = triangles[i];
-        const auto& tj = triangles[j];
-        int shared = 0, sT = -1, sU = -1;
-        for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q)
-                if (ti[p] == tj[q]) {
-                    ++shared;
-                    sT = p;
-                    sU = q;
-                }
-        if (shared >= 2) return;
-        const Vec3 t[3] = {at(ti[0]), at(ti[1]), at(ti[2])};
-        const Vec3 u[3] = {at(tj[0]), at(tj[1]), at(tj[2])};
-        const bool hit = shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU)
-                                     : trianglesIntersect(t, u);
-        if (hit) pairs.emplace_back(i, j);
+    // query per triangle), split into parts that run in parallel and are joined in the walk's
+    // order: the same list for any number of threads. Each part stops at `limit`, enough for
+    // the first `limit` of the whole.
+    constexpr size_t kTasks = 64; // a few per thread, for balance
+    const std::vector<Bvh::PairTask> tasks = tree.pairTasks(tree, kTasks);
+    std::vector<std::vector<std::pair<int, int>>> parts(tasks.size());
+    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
+        std::vector<std::pair<int, int>>& out = parts[k];
+        tree.overlappingPairs(tree, tasks[k], [&](int a, int b) {
+            if (limit > 0 && out.size() >= limit) return;
+            const int i = std::min(a, b), j = std::max(a, b);
+            const auto& ti = triangles[i];
+            const auto& tj = triangles[j];
+            int shared = 0, sT = -1, sU = -1;
+            for (int p = 0; p < 3; ++p)
+                for (int q = 0; q < 3; ++q)
+                    if (ti[p] == tj[q]) {
+                        ++shared;
+                        sT = p;
+                        sU = q;
+                    }
+            if (shared >= 2) return;
+            const Vec3 t[3] = {at(ti[0]), at(ti[1]), at(ti[2])};
+            const Vec3 u[3] = {at(tj[0]), at(tj[1]), at(tj[2])};
+            const bool hit = shared == 1 ? trianglesSharingVertexIntersect(t, sT, u, sU)
+                                         : trianglesIntersect(t, u);
+            if (hit) out.emplace_back(i, j);
+        });
     });
+    for (const auto& part : parts) pairs.insert(pairs.end(), part.begin(), part.end());
+    if (limit > 0 && pairs.size() > limit) pairs.resize(limit);
     return pairs;
 }
 

@@ -87,6 +87,7 @@ void SelfCollisionStats::add(const SelfCollisionStats& o) {
     ccdRounds += o.ccdRounds;
     broadPhases += o.broadPhases;
     halvings += o.halvings;
+    retries += o.retries;
     candidates += o.candidates;
     failSafeRuns += o.failSafeRuns;
     zoneVertices += o.zoneVertices;
@@ -599,6 +600,7 @@ int SelfCollision::proximity() {
     ensureCandidates();
     std::vector<Contact>& contacts = mContacts;
     contacts.clear();
+    size_t vtCount = 0; // the vertex–triangle pairs come first
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
         const std::vector<Candidate>& cands = vt ? mCandVt : mCandEe;
@@ -659,12 +661,10 @@ int SelfCollision::proximity() {
                 out.push_back({p, n, target});
             },
             contacts);
+        if (vt) vtCount = contacts.size();
     }
     mMaybeValid = true;
-    mResting.clear();
-    for (const Contact& c : contacts)
-        if (c.pair.a[0] == 1.0 && c.pair.a[1] <= 0.0 && c.pair.a[2] <= 0.0 && c.pair.a[3] <= 0.0)
-            mResting.push_back(c); // vertex–triangle (α = 1, −w₀, −w₁, −w₂)
+    mResting.assign(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
     for (int it = 0; it < mSettings.proximityIterations; ++it)
         for (const Contact& c : contacts) {
             const double g = c.n.dot(relative(mX1, c.pair));
@@ -681,6 +681,7 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
     ++mStats.ccdRounds;
     std::vector<Contact>& found = mContacts;
     found.clear();
+    size_t vtCount = 0; // the vertex–triangle hits come first
     std::atomic<long long> touching{0};
     for (int kind = 0; kind < 2; ++kind) {
         const bool vt = kind == 0;
@@ -752,9 +753,12 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
                 hitsOut.push_back({p, n, std::max(dt, 1.1 * xiUsed)});
             },
             found);
+        if (vt) vtCount = found.size();
     }
     mStats.startTouching = std::max(mStats.startTouching, touching.load());
     if (apply) {
+        mHitsVt.insert(mHitsVt.end(), found.begin(),
+                       found.begin() + static_cast<std::ptrdiff_t>(vtCount));
         for (const Contact& c : found) {
             const double g1 = c.n.dot(relative(mX1, c.pair));
             if (g1 < c.target) correct(mX1, mInvMass, c.pair, c.n, c.target - g1);
@@ -912,6 +916,7 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
     mLastHits.clear();
+    mHitsVt.clear();
     auto t0 = std::chrono::steady_clock::now();
     std::vector<double> before = mX1;
     mStats.proximityPairs += proximity();
@@ -934,27 +939,59 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
     return mStats;
 }
 
+namespace {
+// Of the planes offered for each vertex, the one it is nearest along its normal (ties: the
+// first); none for held vertices nor for a vertex beyond the plane.
+class NearestPlanes {
+public:
+    NearestPlanes(const std::vector<double>& x, const std::vector<double>& invMass)
+        : mX(x), mInvMass(invMass), mNearest(invMass.size(), INFINITY), mPlane(invMass.size()) {}
+    void offer(int i, const Vec3& nrm, const Vec3& point, const Vec3& velocity,
+               bool closing = false) {
+        if (mInvMass[i] == 0.0) return;
+        const double gap = nrm.dot(Vec3(vec3At(mX.data(), i)) - point);
+        // A corner beyond the vertex along n (a tilted face under a vertex near its edge) is not
+        // held: its plane would push it back by as much.
+        if (!(gap >= 0.0) || !(gap < mNearest[i])) return;
+        mNearest[i] = gap;
+        mPlane[i] = {i, nrm, point, velocity, closing};
+    }
+    // Per body (vertex offsets `offset`, body of each vertex `body`), in vertex order.
+    std::vector<std::vector<ClothContactPlane>> perBody(const std::vector<int>& body,
+                                                        const std::vector<int>& offset) const {
+        std::vector<std::vector<ClothContactPlane>> out(offset.size());
+        for (size_t i = 0; i < mNearest.size(); ++i) {
+            if (!std::isfinite(mNearest[i])) continue;
+            ClothContactPlane p = mPlane[i];
+            p.vertex = static_cast<int>(i) - offset[body[i]];
+            out[body[i]].push_back(p);
+        }
+        return out;
+    }
+
+private:
+    const std::vector<double>& mX;
+    const std::vector<double>& mInvMass;
+    std::vector<double> mNearest;
+    std::vector<ClothContactPlane> mPlane;
+};
+} // namespace
+
+std::vector<int> SelfCollision::bodyOffsets() const {
+    std::vector<int> offset;
+    for (const Member& m : mBodies) offset.push_back(m.offset);
+    return offset;
+}
+
 std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const {
     // For a pair of vertex v (mass m_v, velocity v_v) and triangle point q = Σ w_k x_k (mass
     // m_t = Σ w_k m_k, velocity v_t = Σ w_k v_k), both sides meet at the centre-of-mass velocity
     // u = (m_v v_v + m_t v_t) / (m_v + m_t), as in an inelastic collision: v gets the plane
     // through q with the pair's normal n, the corners the plane through x_v with −n, both moving
-    // at u. Of several planes a vertex keeps the one it is nearest (ties: the first pair).
-    std::vector<std::vector<ClothContactPlane>> out(mBodies.size());
-    if (mResting.empty()) return out; // most passes of a cape in the wind: no per-vertex scratch
-    const size_t n = mVertexBody.size();
-    std::vector<double> nearest(n, INFINITY);
-    std::vector<ClothContactPlane> plane(n);
+    // at u.
+    if (mResting.empty()) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
+    NearestPlanes planes(mX1, mInvMass);
     const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
-    const auto offer = [&](int i, const Vec3& nrm, const Vec3& point, const Vec3& velocity) {
-        if (mInvMass[i] == 0.0) return;
-        const double gap = nrm.dot(at(mX1, i) - point);
-        // A corner beyond the vertex along n (a tilted face under a vertex near its edge) is not
-        // held: its plane would push it back by as much.
-        if (!(gap >= 0.0) || !(gap < nearest[i])) return;
-        nearest[i] = gap;
-        plane[i] = {i, nrm, point, velocity};
-    };
     for (const Contact& c : mResting) {
         const int v = c.pair.v[0];
         // Hair on cloth: the hair meets the cloth in its own solve (World::clothAsColliders),
@@ -971,18 +1008,110 @@ std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const
         const double mv = mMass[v];
         if (!(mv + mt > 0.0)) continue;
         const Vec3 u = (mv * at(mV, v) + mt * vt) / (mv + mt);
-        offer(v, c.n, q, u);
+        planes.offer(v, c.n, q, u);
         for (int k = 1; k < 4; ++k)
-            if (-c.pair.a[k] > 0.3) offer(c.pair.v[k], -c.n, at(mX1, v), u);
+            if (-c.pair.a[k] > 0.3) planes.offer(c.pair.v[k], -c.n, at(mX1, v), u);
     }
+    return planes.perBody(mVertexBody, bodyOffsets());
+}
+
+std::vector<std::vector<ClothContactPlane>>
+SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
+    // The pairs may start far apart (up to a step's approach), so each gets one plane between
+    // its sides, not the other side's point (both sides could then travel into the gap and pass
+    // each other), with the face's normal n (the pair's own may lean, from an edge):
+    // - The plane moves at the velocity u of the contact's cluster (the pairs joined by shared
+    //   vertices): its centre-of-mass velocity at the step's start, or a held vertex's. A
+    //   pair's own centre of mass would have a light corner of one sheet carry the whole
+    //   momentum of the other's face, and the planes of one cluster disagree.
+    // - It starts where the sides, closing on it at their speeds relative to u, reach it
+    //   together: c = x_v + s (q − x_v), s = (v_v − u)·(−n) / ((v_v − v_t)·(−n)) clamped to
+    //   [0, 1] (the mass share m_t / (m_v + m_t) for a pair not closing; 0 or 1 with a held
+    //   side).
+    // - Each side is held ξ/2 off it (ξ when the other side is held): the pair ends ξ apart.
+    std::vector<Contact> pairs = mResting;
+    pairs.insert(pairs.end(), mHitsVt.begin(), mHitsVt.end());
+    if (pairs.empty()) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
+    const size_t n = mVertexBody.size();
+    std::vector<double> vel(3 * n);
+    for (size_t b = 0; b < mBodies.size(); ++b)
+        std::copy(startVelocities[b].data(), startVelocities[b].data() + startVelocities[b].size(),
+                  vel.begin() + 3 * mBodies[b].offset);
+    const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
+    // The clusters, and each one's velocity.
+    std::vector<int> parent(n);
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto find = [&](int i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    std::vector<uint8_t> in(n, 0);
+    for (const Contact& c : pairs)
+        for (int k = 0; k < 4; ++k) {
+            if (k > 0 && !(-c.pair.a[k] > 0.0)) continue;
+            in[c.pair.v[k]] = 1;
+            const int a = find(c.pair.v[0]), b = find(c.pair.v[k]);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    std::vector<double> mass(n, 0.0), heldCount(n, 0.0);
+    std::vector<Vec3> momentum(n, Vec3::Zero()), heldVelocity(n, Vec3::Zero());
     for (size_t i = 0; i < n; ++i) {
-        if (!std::isfinite(nearest[i])) continue;
-        const int b = mVertexBody[i];
-        ClothContactPlane p = plane[i];
-        p.vertex = static_cast<int>(i) - mBodies[b].offset;
-        out[b].push_back(p);
+        if (!in[i]) continue;
+        const int r = find(static_cast<int>(i));
+        if (mInvMass[i] == 0.0) {
+            heldCount[r] += 1.0;
+            heldVelocity[r] += at(vel, static_cast<int>(i));
+        } else {
+            mass[r] += mMass[i];
+            momentum[r] += mMass[i] * at(vel, static_cast<int>(i));
+        }
     }
-    return out;
+    const auto clusterVelocity = [&](int i) -> Vec3 {
+        const int r = find(i);
+        if (heldCount[r] > 0.0) return heldVelocity[r] / heldCount[r];
+        return mass[r] > 0.0 ? Vec3(momentum[r] / mass[r]) : Vec3(Vec3::Zero());
+    };
+    NearestPlanes planes(mX0, mInvMass);
+    for (const Contact& c : pairs) {
+        const int v = c.pair.v[0];
+        if (!mBodyHasTriangles[mVertexBody[v]]) continue; // a hair's vertex (contactPlanes)
+        Vec3 q = Vec3::Zero(), vt = Vec3::Zero();
+        double mt = 0.0, wt = 0.0;
+        bool triangleHeld = false;
+        for (int k = 1; k < 4; ++k) {
+            const double w = -c.pair.a[k];
+            q += w * at(mX0, c.pair.v[k]);
+            vt += w * at(vel, c.pair.v[k]);
+            mt += w * mMass[c.pair.v[k]];
+            wt += w;
+            triangleHeld = triangleHeld || (w > 0.0 && mInvMass[c.pair.v[k]] == 0.0);
+        }
+        const double mv = mMass[v];
+        const bool vertexHeld = mInvMass[v] == 0.0;
+        if ((vertexHeld && triangleHeld) || !(mv + mt > 0.0) || !(wt > 0.0)) continue;
+        Vec3 face = (at(mX0, c.pair.v[2]) - at(mX0, c.pair.v[1]))
+                        .cross(at(mX0, c.pair.v[3]) - at(mX0, c.pair.v[1]));
+        if (!(face.norm() > 0.0)) continue;
+        face.normalize();
+        if (face.dot(c.n) < 0.0) face = -face;
+        const Vec3 u = clusterVelocity(v);
+        const double closing = -(at(vel, v) - vt / wt).dot(face);
+        double s = mt / (mv + mt);
+        if (vertexHeld)
+            s = 0.0;
+        else if (triangleHeld)
+            s = 1.0;
+        else if (closing > 0.0)
+            s = std::clamp(-(at(vel, v) - u).dot(face) / closing, 0.0, 1.0);
+        const Vec3 centre = at(mX0, v) + s * (q - at(mX0, v));
+        const double xi = pairThickness(c.pair);
+        planes.offer(v, face, centre - (triangleHeld ? xi : 0.5 * xi) * face, u, true);
+        for (int k = 1; k < 4; ++k)
+            if (-c.pair.a[k] > 0.3)
+                planes.offer(c.pair.v[k], -face, centre + (vertexHeld ? xi : 0.5 * xi) * face, u,
+                             true);
+    }
+    return planes.perBody(mVertexBody, bodyOffsets());
 }
 
 std::vector<std::pair<std::array<int, 2>, std::array<int, 2>>>

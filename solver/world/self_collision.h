@@ -28,6 +28,7 @@ struct SelfCollisionStats {
     long long frozenVertices = 0; // vertices held at x₀ by the last resort
     long long unresolved = 0;     // hits left after every stage (a guarantee breach; reported)
     long long halvings = 0;       // substeps the World halved because a pass stretched cloth
+    long long retries = 0;        // intervals solved again with the pass's pairs held (World)
     // Pairs skipped because they start touching or crossing (the most in one pass).
     long long startTouching = 0;
     double broadSeconds = 0.0, proximitySeconds = 0.0, ccdSeconds = 0.0, failSafeSeconds = 0.0;
@@ -71,6 +72,12 @@ public:
     // point the mirrored plane through the vertex; pinned vertices none, nor pairs of a hair's
     // vertex.
     std::vector<std::vector<ClothContactPlane>> contactPlanes() const;
+    // The same pairs' planes, and those of the pass's vertex–triangle CCD hits, at the pass's
+    // start positions and velocities (per body): for the interval's solve done again when this pass
+    // had to move cloth too far (World::advanceColliding), so that the solve holds the pairs the
+    // pass found.
+    std::vector<std::vector<ClothContactPlane>>
+    retryPlanes(const std::vector<VecX>& startVelocities) const;
 
     // Intersecting triangle pairs at the bodies' current positions (contact/intersect.h): per
     // body, the pairs with at least one triangle of it.
@@ -164,6 +171,8 @@ private:
     bool mMaybeValid = false;
     std::vector<Pair> mLastHits; // of the last CCD round
     std::vector<Contact> mContacts; // proximity's pairs, or a CCD round's hits (reused buffer)
+    std::vector<int> bodyOffsets() const; // each body's first vertex
+    std::vector<Contact> mHitsVt;         // this pass's vertex–triangle CCD hits (retryPlanes)
     std::vector<Contact> mResting;  // the last proximity's vertex–triangle pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     // Flat patches of the last full gathering: the pairs inside them are left out of the

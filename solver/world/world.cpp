@@ -160,6 +160,10 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
     // rest of the frame (or grows back, WorldSettings::growBack).
     int level = 0;
     int streak = 0; // passes accepted at `level` since it last changed
+    // The cloth planes of the interval's solves: the last accepted pass's, and on a retry the
+    // rejected pass's pairs before them.
+    std::vector<std::vector<ClothContactPlane>> held = mClothPlanes;
+    bool retried = false; // this interval's solve was done again with the pass's pairs
     long tick = 0;
     while (tick < totalTicks) {
         const long end = std::min(totalTicks, tick + (ticksPerBase >> level));
@@ -180,7 +184,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 movedCloth = true;
                 body.forgetColliderBounds(); // the cloth's motion is new each interval
             }
-            if (k < mClothBodies && k < mClothPlanes.size()) body.setClothPlanes(mClothPlanes[k]);
+            if (k < mClothBodies && k < held.size()) body.setClothPlanes(held[k]);
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
@@ -196,6 +200,31 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 after > body.limits().overStretch)
                 stretched = true;
         }
+        // First, the same interval again with the pairs the pass found as contact planes in
+        // its solve (SelfCollision::retryPlanes): the solve then holds them and spreads what the
+        // pass would have done to one vertex over the cloth round it. A vertex the solve left
+        // passing through a face (it came within ξ and went on) is what stretches the cloth when
+        // the pass pushes it back alone.
+        if (stretched && !retried && mSettings.clothContactInSolve) {
+            std::vector<VecX> startV(n);
+            for (size_t k = 0; k < n; ++k) startV[k] = snaps[k].v;
+            const std::vector<std::vector<ClothContactPlane>> planes = mSelf->retryPlanes(startV);
+            bool any = false;
+            for (size_t k = 0; k < n && k < mClothBodies && k < planes.size(); ++k)
+                any = any || !planes[k].empty();
+            retried = true;
+            if (any) {
+                held.resize(std::max(held.size(), planes.size()));
+                for (size_t k = 0; k < n; ++k) {
+                    mBodies[mSelfBodies[k]]->restore(snaps[k]);
+                    if (k < planes.size())
+                        held[k].insert(held[k].begin(), planes[k].begin(), planes[k].end());
+                }
+                runs = runsBefore;
+                ++fs.selfContacts.retries;
+                continue;
+            }
+        }
         if (stretched && level < maxLevel) {
             for (size_t k = 0; k < n; ++k) {
                 mBodies[mSelfBodies[k]]->restore(snaps[k]);
@@ -206,6 +235,8 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             runs = runsBefore;
             ++level;
             streak = 0;
+            held = mClothPlanes;
+            retried = false;
             ++fs.selfContacts.halvings;
             std::snprintf(buf, sizeof buf,
                           "t=%.6g s: self-collision stretched cloth to %.3g × its rest length; "
@@ -222,6 +253,8 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
         if (mSettings.clothContactInSolve) mClothPlanes = mSelf->contactPlanes();
+        held = mClothPlanes;
+        retried = false;
         tick = end;
         // Grow back (WorldSettings::growBack), as stepBody does: two accepted passes at this
         // level and a boundary of the coarser one.
