@@ -665,6 +665,10 @@ int SelfCollision::proximity() {
     }
     mMaybeValid = true;
     mResting.assign(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
+    mPassVt.insert(mPassVt.end(), contacts.begin(),
+                   contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
+    mPassEe.insert(mPassEe.end(), contacts.begin() + static_cast<std::ptrdiff_t>(vtCount),
+                   contacts.end());
     for (int it = 0; it < mSettings.proximityIterations; ++it)
         for (const Contact& c : contacts) {
             const double g = c.n.dot(relative(mX1, c.pair));
@@ -757,8 +761,10 @@ int SelfCollision::ccdRound(bool apply, std::vector<Pair>* hits, const std::vect
     }
     mStats.startTouching = std::max(mStats.startTouching, touching.load());
     if (apply) {
-        mHitsVt.insert(mHitsVt.end(), found.begin(),
+        mPassVt.insert(mPassVt.end(), found.begin(),
                        found.begin() + static_cast<std::ptrdiff_t>(vtCount));
+        mPassEe.insert(mPassEe.end(), found.begin() + static_cast<std::ptrdiff_t>(vtCount),
+                       found.end());
         for (const Contact& c : found) {
             const double g1 = c.n.dot(relative(mX1, c.pair));
             if (g1 < c.target) correct(mX1, mInvMass, c.pair, c.n, c.target - g1);
@@ -916,7 +922,8 @@ SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
                   mX0.begin() + 3 * mBodies[b].offset);
     gather();
     mLastHits.clear();
-    mHitsVt.clear();
+    mPassVt.clear();
+    mPassEe.clear();
     auto t0 = std::chrono::steady_clock::now();
     std::vector<double> before = mX1;
     mStats.proximityPairs += proximity();
@@ -1029,8 +1036,9 @@ SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
     //   [0, 1] (the mass share m_t / (m_v + m_t) for a pair not closing; 0 or 1 with a held
     //   side).
     // - Each side is held ξ/2 off it (ξ when the other side is held): the pair ends ξ apart.
-    std::vector<Contact> pairs = mResting;
-    pairs.insert(pairs.end(), mHitsVt.begin(), mHitsVt.end());
+    std::vector<Contact> pairs = mPassVt;
+    const size_t vtCount = pairs.size();
+    pairs.insert(pairs.end(), mPassEe.begin(), mPassEe.end());
     if (pairs.empty()) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
     const size_t n = mVertexBody.size();
     std::vector<double> vel(3 * n);
@@ -1048,7 +1056,7 @@ SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
     std::vector<uint8_t> in(n, 0);
     for (const Contact& c : pairs)
         for (int k = 0; k < 4; ++k) {
-            if (k > 0 && !(-c.pair.a[k] > 0.0)) continue;
+            if (c.pair.a[k] == 0.0) continue;
             in[c.pair.v[k]] = 1;
             const int a = find(c.pair.v[0]), b = find(c.pair.v[k]);
             if (a != b) parent[std::max(a, b)] = std::min(a, b);
@@ -1072,44 +1080,54 @@ SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
         return mass[r] > 0.0 ? Vec3(momentum[r] / mass[r]) : Vec3(Vec3::Zero());
     };
     NearestPlanes planes(mX0, mInvMass);
-    for (const Contact& c : pairs) {
-        const int v = c.pair.v[0];
-        if (!mBodyHasTriangles[mVertexBody[v]]) continue; // a hair's vertex (contactPlanes)
-        Vec3 q = Vec3::Zero(), vt = Vec3::Zero();
-        double mt = 0.0, wt = 0.0;
-        bool triangleHeld = false;
-        for (int k = 1; k < 4; ++k) {
-            const double w = -c.pair.a[k];
-            q += w * at(mX0, c.pair.v[k]);
-            vt += w * at(vel, c.pair.v[k]);
-            mt += w * mMass[c.pair.v[k]];
-            wt += w;
-            triangleHeld = triangleHeld || (w > 0.0 && mInvMass[c.pair.v[k]] == 0.0);
+    for (size_t ci = 0; ci < pairs.size(); ++ci) {
+        const Contact& c = pairs[ci];
+        // Hair on cloth: the hair meets the cloth in its own solve (contactPlanes).
+        if (!mBodyHasTriangles[mVertexBody[c.pair.v[0]]] ||
+            !mBodyHasTriangles[mVertexBody[c.pair.v[3]]])
+            continue;
+        // The two sides: weights α_k > 0 (the vertex, or the first edge's point) and α_k < 0
+        // (the face's point, or the second edge's); their points, velocities and masses.
+        Vec3 p[2] = {Vec3::Zero(), Vec3::Zero()}, v[2] = {Vec3::Zero(), Vec3::Zero()};
+        double m[2] = {0.0, 0.0}, w[2] = {0.0, 0.0};
+        bool held[2] = {false, false};
+        for (int k = 0; k < 4; ++k) {
+            const int side = c.pair.a[k] > 0.0 ? 0 : 1;
+            const double wk = std::abs(c.pair.a[k]);
+            const int i = c.pair.v[k];
+            p[side] += wk * at(mX0, i);
+            v[side] += wk * at(vel, i);
+            m[side] += wk * mMass[i];
+            w[side] += wk;
+            held[side] = held[side] || (wk > 0.0 && mInvMass[i] == 0.0);
         }
-        const double mv = mMass[v];
-        const bool vertexHeld = mInvMass[v] == 0.0;
-        if ((vertexHeld && triangleHeld) || !(mv + mt > 0.0) || !(wt > 0.0)) continue;
-        Vec3 face = (at(mX0, c.pair.v[2]) - at(mX0, c.pair.v[1]))
-                        .cross(at(mX0, c.pair.v[3]) - at(mX0, c.pair.v[1]));
-        if (!(face.norm() > 0.0)) continue;
-        face.normalize();
-        if (face.dot(c.n) < 0.0) face = -face;
-        const Vec3 u = clusterVelocity(v);
-        const double closing = -(at(vel, v) - vt / wt).dot(face);
-        double s = mt / (mv + mt);
-        if (vertexHeld)
+        if ((held[0] && held[1]) || !(w[0] > 0.0 && w[1] > 0.0) || !(m[0] + m[1] > 0.0)) continue;
+        // The normal: a vertex–triangle pair's face's (on the vertex's side), an edge pair's own.
+        Vec3 nrm = c.n;
+        if (ci < vtCount) {
+            const Vec3 face = (at(mX0, c.pair.v[2]) - at(mX0, c.pair.v[1]))
+                                  .cross(at(mX0, c.pair.v[3]) - at(mX0, c.pair.v[1]));
+            if (face.norm() > 0.0) nrm = face.normalized() * (face.dot(c.n) < 0.0 ? -1.0 : 1.0);
+        }
+        const Vec3 u = clusterVelocity(c.pair.v[0]);
+        const Vec3 va = v[0] / w[0], vb = v[1] / w[1];
+        const double closing = -(va - vb).dot(nrm);
+        double s = m[1] / (m[0] + m[1]); // the first side's share of the gap
+        if (held[0])
             s = 0.0;
-        else if (triangleHeld)
+        else if (held[1])
             s = 1.0;
         else if (closing > 0.0)
-            s = std::clamp(-(at(vel, v) - u).dot(face) / closing, 0.0, 1.0);
-        const Vec3 centre = at(mX0, v) + s * (q - at(mX0, v));
+            s = std::clamp(-(va - u).dot(nrm) / closing, 0.0, 1.0);
+        const Vec3 centre = p[0] + s * (p[1] - p[0]);
         const double xi = pairThickness(c.pair);
-        planes.offer(v, face, centre - (triangleHeld ? xi : 0.5 * xi) * face, u, true);
-        for (int k = 1; k < 4; ++k)
-            if (-c.pair.a[k] > 0.3)
-                planes.offer(c.pair.v[k], -face, centre + (vertexHeld ? xi : 0.5 * xi) * face, u,
-                             true);
+        for (int k = 0; k < 4; ++k) {
+            const int side = c.pair.a[k] > 0.0 ? 0 : 1;
+            if (!(std::abs(c.pair.a[k]) > 0.3)) continue;
+            const double sign = side == 0 ? 1.0 : -1.0;
+            const double off = held[1 - side] ? xi : 0.5 * xi;
+            planes.offer(c.pair.v[k], sign * nrm, centre - sign * off * nrm, u, true);
+        }
     }
     return planes.perBody(mVertexBody, bodyOffsets());
 }

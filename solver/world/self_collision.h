@@ -72,7 +72,7 @@ public:
     // point the mirrored plane through the vertex; pinned vertices none, nor pairs of a hair's
     // vertex.
     std::vector<std::vector<ClothContactPlane>> contactPlanes() const;
-    // The same pairs' planes, and those of the pass's vertex–triangle CCD hits, at the pass's
+    // The planes of all the pass's proximity pairs and CCD hits (edge pairs too) at the pass's
     // start positions and velocities (per body): for the interval's solve done again when this pass
     // had to move cloth too far (World::advanceColliding), so that the solve holds the pairs the
     // pass found.
@@ -172,7 +172,8 @@ private:
     std::vector<Pair> mLastHits; // of the last CCD round
     std::vector<Contact> mContacts; // proximity's pairs, or a CCD round's hits (reused buffer)
     std::vector<int> bodyOffsets() const; // each body's first vertex
-    std::vector<Contact> mHitsVt;         // this pass's vertex–triangle CCD hits (retryPlanes)
+    // This pass's proximity pairs and CCD hits, vertex–triangle and edge–edge (retryPlanes).
+    std::vector<Contact> mPassVt, mPassEe;
     std::vector<Contact> mResting;  // the last proximity's vertex–triangle pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     // Flat patches of the last full gathering: the pairs inside them are left out of the

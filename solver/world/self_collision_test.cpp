@@ -184,35 +184,40 @@ TEST_CASE("self-collision: a sheet thrown at a net at one substep per frame stay
     }
 }
 
+// Two free sheets in zero gravity and still air meeting at 1 m/s each (a 0.4 m sheet of 16² and
+// a 0.3 m one of 13² over it, 10 cm apart): one substep moves them 2 cm closer at 1/24 s, 7 × the
+// thickness.
+std::unique_ptr<World> meetingSheets(WorldSettings ws) {
+    ws.gravity = Vec3::Zero();
+    auto w = std::make_unique<World>(ws);
+    ClothMaterial m;
+    m.lift.value = gale::fields::Param(0.0);
+    m.drag.value = gale::fields::Param(0.0);
+    auto a = std::make_unique<Cloth>(
+        "a", makeGrid(0.4, 0.4, 16, 16, Vec3(-0.2, 0.45, -0.2), Vec3::UnitX(), Vec3::UnitZ()), m);
+    auto b = std::make_unique<Cloth>(
+        "b", makeGrid(0.3, 0.3, 13, 13, Vec3(-0.12, 0.55, -0.17), Vec3::UnitX(), Vec3::UnitZ()), m);
+    a->setVelocities(VecX(Eigen::RowVector3d(0.0, 1.0, 0.0).replicate(1, 256).transpose()));
+    b->setVelocities(VecX(Eigen::RowVector3d(0.0, -1.0, 0.0).replicate(1, 169).transpose()));
+    a->collision().self = b->collision().self = true;
+    w->addBody(std::move(a));
+    w->addBody(std::move(b));
+    return w;
+}
+
 TEST_CASE("self-collision: no energy from contact with no wind", "[solver][self]") {
-    // Two free sheets in zero gravity and still air meet at 1 m/s each (one substep moves them
-    // 2 cm closer, 7 × the thickness): the contact is inelastic, so kinetic + elastic energy
-    // never rises above the start (1 % for the solver's own rounding of elastic energy).
+    // The contact is inelastic, so kinetic + elastic energy never rises above the start (1 % for
+    // the solver's own rounding of elastic energy).
     for (int substeps : {1, 4}) {
         WorldSettings ws;
-        ws.gravity = Vec3::Zero();
         ws.substeps = substeps;
-        World w(ws);
-        ClothMaterial m;
-        m.lift.value = gale::fields::Param(0.0);
-        m.drag.value = gale::fields::Param(0.0);
-        auto a = std::make_unique<Cloth>(
-            "a", makeGrid(0.4, 0.4, 16, 16, Vec3(-0.2, 0.45, -0.2), Vec3::UnitX(), Vec3::UnitZ()),
-            m);
-        auto b = std::make_unique<Cloth>(
-            "b", makeGrid(0.3, 0.3, 13, 13, Vec3(-0.12, 0.55, -0.17), Vec3::UnitX(), Vec3::UnitZ()),
-            m);
-        a->setVelocities(VecX(Eigen::RowVector3d(0.0, 1.0, 0.0).replicate(1, 256).transpose()));
-        b->setVelocities(VecX(Eigen::RowVector3d(0.0, -1.0, 0.0).replicate(1, 169).transpose()));
-        a->collision().self = b->collision().self = true;
-        w.addBody(std::move(a));
-        w.addBody(std::move(b));
+        const std::unique_ptr<World> w = meetingSheets(ws);
         double e0 = 0.0;
-        for (const auto& body : w.bodies()) e0 += body->kineticEnergy() + body->elasticEnergy(0.0);
+        for (const auto& body : w->bodies()) e0 += body->kineticEnergy() + body->elasticEnergy(0.0);
         double worst = 0.0;
         long long hits = 0;
         for (int f = 2; f <= 24; ++f) {
-            const FrameStats fs = w.advanceFrame(f);
+            const FrameStats fs = w->advanceFrame(f);
             REQUIRE_FALSE(fs.failed);
             double e = 0.0;
             for (const auto& body : fs.bodies) e += body.kinetic + body.elastic;
@@ -224,6 +229,55 @@ TEST_CASE("self-collision: no energy from contact with no wind", "[solver][self]
         CHECK(hits > 0);
         CHECK(worst <= 1.01 * e0);
     }
+}
+
+TEST_CASE("self-collision: an interval the pass stretched is solved again with its pairs held",
+          "[solver][self]") {
+    // At one substep the sheets go through each other within the step; the pass pushes them back
+    // alone and stretches them (1.98× and 2.19× rest), so the interval is redone. Solved again
+    // with the pass's pairs held (WorldSettings::clothContactInSolve: SelfCollision::retryPlanes)
+    // the solve stops both sheets where they meet and nothing is halved; with the pass alone
+    // (the control) the interval is halved.
+    struct Run {
+        long long retries = 0, halvings = 0;
+        double stretch = 0.0, energy = 0.0, start = 0.0;
+        int intersecting = 0;
+    };
+    const auto run = [](bool inSolve) {
+        WorldSettings ws;
+        ws.substeps = 1;
+        ws.clothContactInSolve = inSolve;
+        const std::unique_ptr<World> w = meetingSheets(ws);
+        Run r;
+        for (const auto& body : w->bodies()) r.start += body->kineticEnergy();
+        std::vector<const Body*> bodies;
+        for (const auto& body : w->bodies()) bodies.push_back(body.get());
+        for (int f = 2; f <= 12; ++f) {
+            const FrameStats fs = w->advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            r.retries += fs.selfContacts.retries;
+            r.halvings += fs.selfContacts.halvings;
+            double e = 0.0;
+            for (const BodyFrameStats& b : fs.bodies) {
+                r.stretch = std::max(r.stretch, b.maxStretch);
+                e += b.kinetic + b.elastic;
+            }
+            r.energy = std::max(r.energy, e);
+            r.intersecting += intersections(bodies) > 0;
+        }
+        return r;
+    };
+    const Run held = run(true), pass = run(false);
+    CAPTURE(held.retries, held.halvings, held.stretch, held.energy, pass.retries, pass.halvings,
+            pass.stretch, pass.energy, held.start);
+    CHECK(held.retries >= 1);
+    CHECK(held.halvings == 0);
+    CHECK(held.stretch < 1.05);
+    CHECK(held.energy <= 1.01 * held.start);
+    CHECK(held.intersecting == 0);
+    CHECK(pass.retries == 0);
+    CHECK(pass.halvings >= 1);
+    CHECK(pass.intersecting == 0);
 }
 
 TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self]") {
