@@ -92,6 +92,10 @@ void FlatPatches::setTopology(const std::vector<std::array<int, 3>>& tris, std::
         mInterior[i] = !open[i] && mVertTriStart[i + 1] > mVertTriStart[i];
 }
 
+bool FlatPatches::narrowEnough(const Cone& c, double thickness) {
+    return c.angle < kHalfPi && std::cos(c.angle) * c.height >= kClearance * thickness;
+}
+
 void FlatPatches::merge(Cone& into, const Cone& c) const {
     into.height = std::min(into.height, c.height);
     if (into.angle >= kHalfPi || c.angle >= kHalfPi) {
@@ -201,8 +205,7 @@ int FlatPatches::find(const contact::Bvh& triTree, const std::vector<double>& x0
         stack.pop_back();
         const Cone& c = mNodeCone[static_cast<std::size_t>(k)];
         const contact::Bvh::NodeView n = triTree.node(k);
-        if (n.end - n.begin >= kMinPatch && c.angle < kHalfPi &&
-            std::cos(c.angle) * c.height >= kClearance * thickness) {
+        if (n.end - n.begin >= kMinPatch && narrowEnough(c, thickness)) {
             members.clear();
             const int stamp = mNextStamp++;
             for (int i = n.begin; i < n.end; ++i) {
@@ -256,7 +259,7 @@ std::size_t FlatPatches::recertify(const std::vector<double>& x0, const std::vec
             for (std::size_t i = 0; i + width < cones.size(); i += 2 * width)
                 merge(cones[i], cones[i + width]);
         const Cone& cone = cones.front();
-        if (cone.angle < kHalfPi && std::cos(cone.angle) * cone.height >= kClearance * thickness &&
+        if (narrowEnough(cone, thickness) &&
             starContour(members, stamp, cone.axis, x0, x1, slack)) {
             keptTris.insert(keptTris.end(), members.begin(), members.end());
             keptStart.push_back(static_cast<int>(keptTris.size()));

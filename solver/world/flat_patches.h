@@ -63,6 +63,9 @@ private:
         double height = 0.0; // the smallest altitude of its triangles (m), a lower bound
     };
     void merge(Cone& into, const Cone& c) const;
+    // Tests 1 and 3 (the cone narrower than 90°, and cos θ × the smallest altitude ≥ 1.01 ξ), as
+    // find() and recertify() both ask them before the contour's.
+    static bool narrowEnough(const Cone& c, double thickness);
     // Triangle t's cone and altitude bound over the step (slack d).
     Cone triangleCone(std::size_t t, const std::vector<double>& x0, const std::vector<double>& x1,
                       double d) const;

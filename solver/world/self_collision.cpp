@@ -492,7 +492,7 @@ bool SelfCollision::ensureCandidates() {
     mRegionHi.resize(3 * n);
     for (size_t i = 0; i < n; ++i) setRegion(i, delta);
     refitBoxes(mRegionLo, mRegionHi, 0.5 * mMaxThickness);
-    labelFlatPatches(flatSlack());
+    labelFlatPatches();
     gatherCandidates(mCandVt, mCandEe);
     mCandidatesValid = true;
     mMaybeValid = false;
@@ -506,10 +506,10 @@ double SelfCollision::flatSlack() const {
     return kFlatSlack * mMaxThickness;
 }
 
-void SelfCollision::labelFlatPatches(double slack) {
+void SelfCollision::labelFlatPatches() {
     mInPatch.clear();
     const int patches =
-        mSettings.flatPatches ? mFlat.find(mTriTree, mX0, mX1, slack, mMaxThickness) : 0;
+        mSettings.flatPatches ? mFlat.find(mTriTree, mX0, mX1, flatSlack(), mMaxThickness) : 0;
     if (patches == 0) {
         mVertTree.clearLabels();
         mTriTree.clearLabels();

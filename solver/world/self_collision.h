@@ -121,9 +121,9 @@ private:
     // The candidates again after the vertices marked in `moved` (and only they) moved beyond
     // the allowance: the pairs of unmoved vertices kept, those with a moved one queried anew.
     void regatherMoved(const std::vector<uint8_t>& moved);
-    // After a full gathering's refit: the flat patches of the step (slack δ), as labels that
-    // prune the trees' pair walks, and the positions they were certified at.
-    void labelFlatPatches(double slack);
+    // After a full gathering's refit: the flat patches of the step (slack flatSlack()), as
+    // labels that prune the trees' pair walks, and the positions they were certified at.
+    void labelFlatPatches();
     double flatSlack() const;
     bool restClose(const Pair& p, bool vertexTriangle) const;
     bool adjacent(int a, int b) const;
