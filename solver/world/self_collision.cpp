@@ -78,6 +78,24 @@ void parallelCollect(size_t n, Fn&& fn, std::vector<T>& all) {
     all.reserve(total);
     for (auto& p : parts) all.insert(all.end(), p.begin(), p.end());
 }
+// Disjoint sets of vertices (union–find with path halving); a set's root is its smallest member,
+// so the sets do not depend on the order they were joined in.
+class DisjointSets {
+public:
+    explicit DisjointSets(size_t n) : mParent(n) { std::iota(mParent.begin(), mParent.end(), 0); }
+    int find(int i) {
+        while (mParent[i] != i) i = mParent[i] = mParent[mParent[i]];
+        return i;
+    }
+    void join(int a, int b) {
+        a = find(a);
+        b = find(b);
+        if (a != b) mParent[std::max(a, b)] = std::min(a, b);
+    }
+
+private:
+    std::vector<int> mParent;
+};
 } // namespace
 
 void SelfCollisionStats::add(const SelfCollisionStats& o) {
@@ -664,7 +682,7 @@ int SelfCollision::proximity() {
         if (vt) vtCount = contacts.size();
     }
     mMaybeValid = true;
-    mResting.assign(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
+    mResting = vtCount; // proximity runs first in a pass: mPassVt is empty before it
     mPassVt.insert(mPassVt.end(), contacts.begin(),
                    contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
     mPassEe.insert(mPassEe.end(), contacts.begin() + static_cast<std::ptrdiff_t>(vtCount),
@@ -864,25 +882,17 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
     mD0.resize(3 * n);
     for (size_t k = 0; k < 3 * n; ++k) mD0[k] = mX1[k] - mX0[k];
     mV0 = mV;
-    std::vector<int> parent(n);
-    std::iota(parent.begin(), parent.end(), 0);
+    DisjointSets sets(n);
     std::vector<uint8_t> inZone(n, 0);
-    const auto find = [&](int i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
-    };
     int round = 0;
     for (; round < mSettings.zoneRounds && !hits.empty(); ++round) {
         for (const Pair& p : hits) {
             for (int k = 0; k < 4; ++k) inZone[p.v[k]] = 1;
-            for (int k = 1; k < 4; ++k) {
-                const int a = find(p.v[0]), b = find(p.v[k]);
-                if (a != b) parent[std::max(a, b)] = std::min(a, b);
-            }
+            for (int k = 1; k < 4; ++k) sets.join(p.v[0], p.v[k]);
         }
         std::vector<std::vector<int>> zones(n);
         for (size_t i = 0; i < n; ++i)
-            if (inZone[i]) zones[find(static_cast<int>(i))].push_back(static_cast<int>(i));
+            if (inZone[i]) zones[sets.find(static_cast<int>(i))].push_back(static_cast<int>(i));
         std::vector<int> zoneOf(n, -1);
         const std::vector<double> before = mX1;
         for (const auto& z : zones)
@@ -996,10 +1006,11 @@ std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const
     // u = (m_v v_v + m_t v_t) / (m_v + m_t), as in an inelastic collision: v gets the plane
     // through q with the pair's normal n, the corners the plane through x_v with −n, both moving
     // at u.
-    if (mResting.empty()) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
+    if (mResting == 0) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
     NearestPlanes planes(mX1, mInvMass);
     const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
-    for (const Contact& c : mResting) {
+    for (size_t r = 0; r < mResting; ++r) {
+        const Contact& c = mPassVt[r];
         const int v = c.pair.v[0];
         // Hair on cloth: the hair meets the cloth in its own solve (World::clothAsColliders),
         // and the cloth is not held against a strand.
@@ -1047,25 +1058,19 @@ SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
                   vel.begin() + 3 * mBodies[b].offset);
     const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
     // The clusters, and each one's velocity.
-    std::vector<int> parent(n);
-    std::iota(parent.begin(), parent.end(), 0);
-    const auto find = [&](int i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
-    };
+    DisjointSets sets(n);
     std::vector<uint8_t> in(n, 0);
     for (const Contact& c : pairs)
         for (int k = 0; k < 4; ++k) {
             if (c.pair.a[k] == 0.0) continue;
             in[c.pair.v[k]] = 1;
-            const int a = find(c.pair.v[0]), b = find(c.pair.v[k]);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+            sets.join(c.pair.v[0], c.pair.v[k]);
         }
     std::vector<double> mass(n, 0.0), heldCount(n, 0.0);
     std::vector<Vec3> momentum(n, Vec3::Zero()), heldVelocity(n, Vec3::Zero());
     for (size_t i = 0; i < n; ++i) {
         if (!in[i]) continue;
-        const int r = find(static_cast<int>(i));
+        const int r = sets.find(static_cast<int>(i));
         if (mInvMass[i] == 0.0) {
             heldCount[r] += 1.0;
             heldVelocity[r] += at(vel, static_cast<int>(i));
@@ -1075,7 +1080,7 @@ SelfCollision::retryPlanes(const std::vector<VecX>& startVelocities) const {
         }
     }
     const auto clusterVelocity = [&](int i) -> Vec3 {
-        const int r = find(i);
+        const int r = sets.find(i);
         if (heldCount[r] > 0.0) return heldVelocity[r] / heldCount[r];
         return mass[r] > 0.0 ? Vec3(momentum[r] / mass[r]) : Vec3(Vec3::Zero());
     };

@@ -174,7 +174,7 @@ private:
     std::vector<int> bodyOffsets() const; // each body's first vertex
     // This pass's proximity pairs and CCD hits, vertex–triangle and edge–edge (retryPlanes).
     std::vector<Contact> mPassVt, mPassEe;
-    std::vector<Contact> mResting;  // the last proximity's vertex–triangle pairs (contactPlanes)
+    size_t mResting = 0; // mPassVt's first ones: the last proximity's pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     // Flat patches of the last full gathering: the pairs inside them are left out of the
     // candidates while every vertex of a patch stays within δ of both ends of the path they were
