@@ -97,14 +97,23 @@ bool trianglesSharingVertexIntersect(const Vec3 t[3], int sharedT, const Vec3 u[
 std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
                                                    const std::vector<std::array<int, 3>>& triangles,
                                                    size_t limit) {
+    Bvh tree;
+    return intersectingPairs(x, triangles, tree, limit);
+}
+
+std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
+                                                   const std::vector<std::array<int, 3>>& triangles,
+                                                   Bvh& tree, size_t limit) {
     std::vector<std::pair<int, int>> pairs;
     if (triangles.size() < 2) return pairs;
     const auto at = [&](int v) { return Vec3(x[3 * v], x[3 * v + 1], x[3 * v + 2]); };
     std::vector<Box> boxes(triangles.size());
     for (size_t i = 0; i < triangles.size(); ++i)
         for (int k = 0; k < 3; ++k) boxes[i].add(at(triangles[i][k]));
-    Bvh tree;
-    tree.build(boxes);
+    if (tree.primitiveCount() == triangles.size())
+        tree.refit(boxes);
+    else
+        tree.build(boxes);
     // The pairs whose boxes overlap, by one walk of the tree against itself (cheaper than a
     // query per triangle), split into parts that run in parallel and are joined in the walk's
     // order: the same list for any number of threads. Each part stops at `limit`, enough for

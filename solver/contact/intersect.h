@@ -3,6 +3,7 @@
 // of segments against triangles, with an AABB tree (bvh.h) as the broad phase.
 #pragma once
 
+#include "solver/contact/bvh.h"
 #include "solver/contact/ccd.h"
 
 #include <array>
@@ -40,5 +41,11 @@ bool trianglesSharingVertexIntersect(const Vec3 t[3], int sharedT, const Vec3 u[
 std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
                                                    const std::vector<std::array<int, 3>>& triangles,
                                                    size_t limit = 0);
+// The same with the caller's tree kept from call to call: built over the first call's positions
+// (or when the triangle count changed), refitted after (a mesh checked every frame pays a refit,
+// not a build; the pairs are the same, their order the kept tree's walk's).
+std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
+                                                   const std::vector<std::array<int, 3>>& triangles,
+                                                   Bvh& tree, size_t limit = 0);
 
 } // namespace gale::solver::contact

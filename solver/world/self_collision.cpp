@@ -1144,7 +1144,7 @@ SelfCollision::intersections() const {
         std::copy(m.body->positions().data(),
                   m.body->positions().data() + m.body->positions().size(),
                   x.begin() + 3 * m.offset);
-    const auto pairs = contact::intersectingPairs(x, mTris);
+    const auto pairs = contact::intersectingPairs(x, mTris, mCountTree);
     std::vector<int> firstTri(mBodies.size() + 1, static_cast<int>(mTris.size()));
     for (int t = static_cast<int>(mTris.size()) - 1; t >= 0; --t) firstTri[mTriBody[t]] = t;
     std::vector<std::pair<std::array<int, 2>, std::array<int, 2>>> out;

@@ -161,6 +161,9 @@ private:
     std::vector<int> mAdjacencyStart, mAdjacency; // vertex neighbours by edges (CSR)
     std::vector<double> mRest, mX0, mX1, mV, mInvMass, mMass, mThick, mD0, mV0;
     contact::Bvh mVertTree, mTriTree, mEdgeTree;
+    // The intersection count's tree over the triangles at their current positions, refitted at
+    // each count (intersections(): a cache, hence mutable).
+    mutable contact::Bvh mCountTree;
     std::vector<Candidate> mCandVt, mCandEe;
     // Per vertex, the region (box, 3 lo and 3 hi per vertex) the candidates cover it in.
     std::vector<double> mRegionLo, mRegionHi;
