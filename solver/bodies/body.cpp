@@ -1035,13 +1035,18 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
     for (;; ++cuts) {
         mDv = alpha * dvLin;
         trialX = x0 + h * (v0 + mDv) + mYPos;
-        const double eTrial = elasticAt(trialX, t1, fElTrial);
-        phiTrial = phi(mDv, eTrial, dvBase);
-        const bool ok = slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
-        if (ok && std::isfinite(phiTrial) && stretchFeasible(trialX)) {
-            energy = eTrial;
-            mFel = fElTrial;
-            break;
+        // Feasibility first: a trial the over-stretch rule refuses is cut without its energy
+        // (a pass over the edges instead of a force evaluation; the accepted step is the same).
+        if (stretchFeasible(trialX)) {
+            const double eTrial = elasticAt(trialX, t1, fElTrial);
+            phiTrial = phi(mDv, eTrial, dvBase);
+            const bool ok =
+                slope < 0.0 ? phiTrial <= phi0 + kArmijo * alpha * slope : phiTrial < phi0;
+            if (ok && std::isfinite(phiTrial)) {
+                energy = eTrial;
+                mFel = fElTrial;
+                break;
+            }
         }
         if (cuts == kMaxCuts) { // no part of the linearised step helps: Newton from Δv = 0
             mDv = dvBase;
@@ -1095,6 +1100,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
         for (cuts = 0; cuts <= kMaxCuts; ++cuts, alpha *= 0.5) {
             mDv = dvBase + alpha * delta;
             trialX = x0 + h * (v0 + mDv) + mYPos;
+            if (!stretchFeasible(trialX)) continue; // cut before its energy, as above
             const double eTrial = elasticAt(trialX, t1, fElTrial);
             phiTrial = phi(mDv, eTrial, dvBase);
             bool ok = std::isfinite(phiTrial) &&
@@ -1105,7 +1111,7 @@ void Body::newton(const Environment& env, ForceInput& in, ForceOutput& out, cons
                 residualAt(mDv, x0, v0, h, in, out, env.gravity, false);
                 ok = mResidual2 <= (1.0 - kArmijo * alpha) * base2;
             }
-            if (ok && stretchFeasible(trialX)) {
+            if (ok) {
                 energy = eTrial;
                 mFel = fElTrial;
                 accepted = true;
