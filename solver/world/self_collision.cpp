@@ -636,10 +636,24 @@ int SelfCollision::proximity() {
                 // Early out: the boxes' distance g ≤ d₁, so g − l > ξ (with a margin far above
                 // the rounding of either distance) means d₁ − l > ξ > ξ_c: no contact and
                 // nothing for CCD — what the exact distance below would decide.
-                if (boxGap(mX1, p, vt) - l > xi * (1.0 + kBoundMargin)) return;
+                // A vertex–triangle pair with a held side (a pin, an attachment) is looked at out
+                // to planeReach × ξ as well (the near pairs below).
+                bool heldSide = false;
+                for (int k = 0; k < 4 && vt; ++k) heldSide = heldSide || mInvMass[p.v[k]] == 0.0;
+                const double reach = heldSide ? std::max(xi, mSettings.planeReach * xi) : xi;
+                const double gap = boxGap(mX1, p, vt);
+                if (gap - l > xi * (1.0 + kBoundMargin) && gap > reach * (1.0 + kBoundMargin))
+                    return;
                 double d1 = 0.0, d0 = 0.0;
                 const Vec3 r1 = closestPair(mX1, p, vt, d1);
                 if (!(d1 - l > mSettings.ccdFraction * xi)) maybe[c] = 1;
+                // Near a held side, not within ξ: the next step's solve gets its plane as well
+                // (contactPlanes; marked here by a negative target). The pass can move only the
+                // free side of such a pair, so the push it would need once the free side has
+                // crossed into ξ lands on a few vertices and stretches the cloth round them.
+                if (d1 >= xi && d1 < reach && d1 > kTouching && !restClose(p, vt) &&
+                    !neighbours(p, vt))
+                    out.push_back({p, contactNormal(mX1, p, vt, r1, d1), -1.0});
                 // Within ξ at the end, or at the start (d₀ ≥ d₁ − l): a pair in resting contact
                 // keeps its side and normal from x₀ even when the step would take it through.
                 if (!(d1 < xi) && !(d1 - l < xi)) return;
@@ -682,6 +696,13 @@ int SelfCollision::proximity() {
         if (vt) vtCount = contacts.size();
     }
     mMaybeValid = true;
+    // The near pairs (vertex–triangle only) apart: planes for the next step, not corrected.
+    mNearVt.clear();
+    const auto near = std::stable_partition(contacts.begin(), contacts.begin() + vtCount,
+                                            [](const Contact& c) { return c.target >= 0.0; });
+    mNearVt.assign(near, contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
+    contacts.erase(near, contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
+    vtCount -= mNearVt.size();
     mResting = vtCount; // proximity runs first in a pass: mPassVt is empty before it
     mPassVt.insert(mPassVt.end(), contacts.begin(),
                    contacts.begin() + static_cast<std::ptrdiff_t>(vtCount));
@@ -1006,11 +1027,12 @@ std::vector<std::vector<ClothContactPlane>> SelfCollision::contactPlanes() const
     // u = (m_v v_v + m_t v_t) / (m_v + m_t), as in an inelastic collision: v gets the plane
     // through q with the pair's normal n, the corners the plane through x_v with −n, both moving
     // at u.
-    if (mResting == 0) return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
+    if (mResting == 0 && mNearVt.empty())
+        return std::vector<std::vector<ClothContactPlane>>(mBodies.size());
     NearestPlanes planes(mX1, mInvMass);
     const auto at = [](const std::vector<double>& v, int i) { return Vec3(vec3At(v.data(), i)); };
-    for (size_t r = 0; r < mResting; ++r) {
-        const Contact& c = mPassVt[r];
+    for (size_t r = 0; r < mResting + mNearVt.size(); ++r) {
+        const Contact& c = r < mResting ? mPassVt[r] : mNearVt[r - mResting];
         const int v = c.pair.v[0];
         // Hair on cloth: the hair meets the cloth in its own solve (World::clothAsColliders),
         // and the cloth is not held against a strand.

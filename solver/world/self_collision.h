@@ -45,6 +45,12 @@ struct SelfCollisionSettings {
     // The broad phase skips pairs inside certified flat patches of cloth (flat_patches.h): the
     // same pairs are corrected either way, found with less work.
     bool flatPatches = true;
+    // Vertex–triangle pairs with a held side (a pinned or attached vertex) closer than this × ξ
+    // at the end of a pass, not only those within ξ, hold their free side in the next step's
+    // solve (contactPlanes): cloth pressed against its own pinned collar is stopped at ξ there,
+    // instead of crossing into it and being pushed back by the next pass, which can move only
+    // the free side and stretches the cloth round it. ≤ 1: the pairs within ξ only.
+    double planeReach = 1.5;
 };
 
 class SelfCollision {
@@ -177,6 +183,9 @@ private:
     std::vector<int> bodyOffsets() const; // each body's first vertex
     // This pass's proximity pairs and CCD hits, vertex–triangle and edge–edge (retryPlanes).
     std::vector<Contact> mPassVt, mPassEe;
+    // The last proximity's vertex–triangle pairs with a held side, beyond ξ but within
+    // planeReach × ξ at x₁ (contactPlanes).
+    std::vector<Contact> mNearVt;
     size_t mResting = 0; // mPassVt's first ones: the last proximity's pairs (contactPlanes)
     std::vector<contact::Box> mVertBoxes, mTriBoxes, mEdgeBoxes;
     // Flat patches of the last full gathering: the pairs inside them are left out of the

@@ -3,7 +3,7 @@
 // wind, the impact-zone fail-safe on its own (momentum, no distance shrinking, no crossing on
 // the corrected path), results that do not depend on the threads, a start that already
 // intersects (reported, kept from getting worse), and hair and cloth resting on cloth held in
-// their own solves.
+// their own solves (cloth pressed against pinned cloth from 1.5 ξ).
 #include "solver/world/self_collision.h"
 
 #include "solver/bodies/cloth.h"
@@ -557,4 +557,70 @@ TEST_CASE("self-collision: cloth resting on cloth is held in its own solve", "[s
     CHECK(pass.constraints == 0);
     CHECK(solve.constraints > 1000);
     CHECK(solve.at49 - solve.at25 <= 0.01 * solve.start);
+}
+
+TEST_CASE("self-collision: cloth pressed against pinned cloth is held in its solve from near it",
+          "[solver][self]") {
+    // A free 0.4 m sheet (16 × 16) lying 1.2 ξ above a 0.6 m sheet pinned everywhere (a table of
+    // cloth), in gravity, one substep a frame (the cape pressed against its own pinned collar).
+    // The pass can move only the free side of a pair with the table; held in the solve from
+    // 1.5 ξ (WorldSettings::clothPlaneReach) instead of from ξ, the sheet is stopped at ξ by its
+    // solve rather than falling into ξ and being pushed back by the pass: the pass's proximity
+    // pairs and CCD hits fall, no more intervals are solved again or halved, the sheet
+    // stretches no more, and nothing intersects either way.
+    struct Run {
+        long long pairs = 0, ccd = 0, redone = 0, constraints = 0;
+        int intersecting = 0;
+        double stretch = 0.0;
+    };
+    const auto run = [](double reach) {
+        WorldSettings ws;
+        ws.substeps = 1;
+        ws.clothPlaneReach = reach;
+        World w(ws);
+        ClothMaterial m;
+        m.lift.value = gale::fields::Param(0.0);
+        m.drag.value = gale::fields::Param(0.0);
+        const double xi = 0.003;
+        auto table = std::make_unique<Cloth>(
+            "table",
+            makeGrid(0.6, 0.6, 20, 20, Vec3(-0.3, 0.5, -0.3), Vec3::UnitX(), Vec3::UnitZ()), m);
+        PinSet all;
+        for (int i = 0; i < 400; ++i) all.vertices.push_back(i);
+        table->addPins(all);
+        auto top =
+            std::make_unique<Cloth>("sheet",
+                                    makeGrid(0.4, 0.4, 16, 16, Vec3(-0.18, 0.5 + 1.2 * xi, -0.22),
+                                             Vec3::UnitX(), Vec3::UnitZ()),
+                                    m);
+        Body* sheet = top.get();
+        for (Body* b : {static_cast<Body*>(table.get()), sheet}) {
+            b->collision().self = true;
+            b->collision().thickness = xi;
+        }
+        w.addBody(std::move(table));
+        w.addBody(std::move(top));
+        Run r;
+        for (int f = 2; f <= 25; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            r.pairs += fs.selfContacts.proximityPairs;
+            r.ccd += fs.selfContacts.ccdHits;
+            r.redone += fs.selfContacts.halvings + fs.selfContacts.retries;
+            r.constraints += fs.bodies[1].clothConstraints;
+            r.stretch = std::max(r.stretch, sheet->maxEdgeStretch());
+            r.intersecting += intersections({w.bodies()[0].get(), sheet}) > 0;
+        }
+        return r;
+    };
+    const Run within = run(1.0), near = run(1.5);
+    CAPTURE(within.pairs, near.pairs, within.ccd, near.ccd, within.redone, near.redone,
+            within.constraints, near.constraints, within.stretch, near.stretch);
+    CHECK(within.intersecting == 0);
+    CHECK(near.intersecting == 0);
+    CHECK(near.pairs * 2 < within.pairs);
+    CHECK(near.ccd < within.ccd);
+    CHECK(near.redone < within.redone);
+    CHECK(near.stretch <= within.stretch);
+    CHECK(near.constraints > within.constraints);
 }

@@ -70,7 +70,9 @@ FrameStats World::advance(double t0, double dt, int substeps) {
 
 void World::setUpSelfCollision(FrameStats& fs) {
     mSelfSetUp = true;
-    auto self = std::make_unique<SelfCollision>();
+    SelfCollisionSettings selfSettings;
+    selfSettings.planeReach = mSettings.clothPlaneReach;
+    auto self = std::make_unique<SelfCollision>(selfSettings);
     for (size_t b = 0; b < mBodies.size(); ++b) {
         Body& body = *mBodies[b];
         const auto* tris = body.collisionTriangles();
