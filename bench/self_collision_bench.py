@@ -10,6 +10,8 @@
 # wall and user CPU seconds of the process (the machine is shared: CPU seconds scatter less).
 #   bench/self_collision_bench.py [--build build] [--repeats 1] [--quick] [--only cape|fold]
 #                                 [--baseline /work/main/build]
+#   bench/self_collision_bench.py --only gusts [--strengths 20,22,...] [--threads 1]
+#     (the cape at several gust strengths: one trajectory is chaotic, their sum is fairer)
 import argparse
 import json
 import os
@@ -28,12 +30,12 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "cli"))
 import count_intersections  # noqa: E402  (the independent counter, beside the CLI tests)
 
 
-def scene(on, thickness, substeps):
-    """The 64x64 cape: the example's text with the resolution, the gust, substeps and the
-    self-collision keys replaced."""
+def scene(on, thickness, substeps, strength=25.0):
+    """The 64x64 cape: the example's text with the resolution, the gust (its strength, m/s),
+    substeps and the self-collision keys replaced."""
     text = open(CAPE).read()
     text = re.sub(r"res = \[\d+, \d+\]", "res = [64, 64]", text)
-    text = re.sub(r"(?m)^strength = .*$", "strength = 25.0", text)
+    text = re.sub(r"(?m)^strength = .*$", "strength = %g" % strength, text)
     text = re.sub(r"(?m)^substeps = \d+", "substeps = %d" % substeps, text)
     text = re.sub(r"(?m)^(self_collision|thickness) = .*\n", "", text)
     text = re.sub(r"(?m)^(drag = .*)$", r"\1\nself_collision = %s\nthickness = %g"
@@ -134,6 +136,42 @@ def folding(args, work):
     print()
 
 
+def gusts(args, work):
+    """The cape at several gust strengths (one chaotic trajectory each: the cape's halvings and
+    the pass's work vary by 2-3x from one strength to the next), on and off back to back, per
+    strength and summed; with --baseline, that build's pair of runs before this one's."""
+    strengths = [float(v) for v in args.strengths.split(",")]
+    builds = [("this", args.build)]
+    if args.baseline:
+        builds.insert(0, ("baseline", args.baseline))
+    print("### 64x64 cape, gust strengths %s m/s, 3 mm, 4 substeps, 48 frames, %d thread(s)\n"
+          % (args.strengths, args.threads))
+    print("| build | strength m/s | off CPU s | on CPU s | on / off CPU | off s | on s | on / off "
+          "| halved | solved again | on: pairs |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    total = {label: [0.0, 0.0, 0.0, 0.0, 0, 0] for label, _ in builds}
+    for strength in strengths:
+        for label, build in builds:
+            tag = "%s%g" % (label, strength)
+            off, offCpu, _, _ = runGale(args, build, work, "goff" + tag,
+                                        scene(False, 0.003, 4, strength), args.threads)
+            on, onCpu, data, out = runGale(args, build, work, "gon" + tag,
+                                           scene(True, 0.003, 4, strength), args.threads)
+            halved = sum(f.get("self_collision", {}).get("halvings", 0) for f in data["frames"])
+            again = sum(f.get("self_collision", {}).get("retries", 0) for f in data["frames"])
+            t = total[label]
+            for k, v in enumerate((offCpu, onCpu, off, on, halved, again)):
+                t[k] += v
+            print("| %s | %g | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f× | %d | %d | %d |"
+                  % (label, strength, offCpu, onCpu, onCpu / offCpu, off, on, on / off, halved,
+                     again, pairs(out)), flush=True)
+    for label, _ in builds:
+        t = total[label]
+        print("| %s | all | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %d | %d | |"
+              % (label, t[0], t[1], t[1] / t[0], t[2], t[3], t[3] / t[2], t[4], t[5]))
+    print()
+
+
 def frames(out, step):
     names = sorted(n for n in os.listdir(out) if n.endswith(".obj"))
     return [os.path.join(out, n) for n in names[::step]]
@@ -157,13 +195,19 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--quick", action="store_true", help="threads tables only")
-    ap.add_argument("--only", choices=("cape", "fold"), help="one scene's tables")
+    ap.add_argument("--only", choices=("cape", "fold", "gusts"), help="one scene's tables")
+    ap.add_argument("--strengths", default="20,22,24,25,26,28,30",
+                    help="--only gusts: the gust strengths (m/s) of the cape")
+    ap.add_argument("--threads", type=int, default=1, help="--only gusts: threads")
     ap.add_argument("--baseline", help="another build folder whose gale runs alternately")
     ap.add_argument("--distance-step", type=int, default=4,
                     help="minimum distance on every N-th frame (it costs ~1 s a frame)")
     args = ap.parse_args()
     work = tempfile.mkdtemp(prefix="gale_selfcoll_bench.")
     try:
+        if args.only == "gusts":
+            gusts(args, work)
+            return
         if args.only != "cape":
             folding(args, work)
         if args.only == "fold":

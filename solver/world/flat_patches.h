@@ -97,4 +97,8 @@ private:
     std::vector<uint8_t> mInPatch;
 };
 
+// The angle between a and b (rad, in [0, π]) bounded from above within 3.2e-5 (a polynomial
+// arctangent; the cones widen by it and stay conservative).
+double angleUpperBound(const Vec3& a, const Vec3& b);
+
 } // namespace gale::solver

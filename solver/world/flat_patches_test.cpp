@@ -262,3 +262,32 @@ TEST_CASE("flat patches: triangles narrower than ξ are left to the pair walk",
     CHECK(v.leftOut > 100); // the left half's pairs
     CHECK(v.leftOutMin > xi);
 }
+
+TEST_CASE("flat patches: the cones' angle bound lies above the true angle, within 3.2e-5 rad",
+          "[flat_patches]") {
+    // Against libm's atan2 (the exact angle to rounding): random directions, and pairs near
+    // parallel, orthogonal and opposite (the polynomial's ends and the octants' seams).
+    std::mt19937 rng(7);
+    std::normal_distribution<double> g;
+    double worstBelow = 0.0, worstAbove = 0.0;
+    const auto check = [&](const Vec3& a, const Vec3& b) {
+        const double exact = std::atan2(a.cross(b).norm(), a.dot(b));
+        const double bound = angleUpperBound(a, b);
+        worstBelow = std::max(worstBelow, exact - bound);
+        worstAbove = std::max(worstAbove, bound - exact);
+    };
+    for (int k = 0; k < 100000; ++k) {
+        const Vec3 a(g(rng), g(rng), g(rng)), b(g(rng), g(rng), g(rng));
+        check(a, b);
+        const double t = std::ldexp(1.0, -(k % 40)); // 1 … 2⁻³⁹ rad off
+        const Vec3 u = a.normalized(), w = a.cross(b).normalized().cross(u);
+        check(u, std::cos(t) * u + std::sin(t) * w);                     // near parallel
+        check(u, -std::cos(t) * u + std::sin(t) * w);                    // near opposite
+        check(u, std::sin(t) * u + std::cos(t) * w);                     // near orthogonal
+        check(u, std::cos(0.25 * M_PI + t) * u + std::sin(0.25 * M_PI + t) * w); // at the seam
+    }
+    check(Vec3::Zero(), Vec3::UnitX());
+    CAPTURE(worstBelow, worstAbove);
+    CHECK(worstBelow <= 0.0);
+    CHECK(worstAbove <= 3.2e-5);
+}
