@@ -39,7 +39,8 @@ double quadraticMinimum(double b0, double b1, double b2) {
 constexpr double kAtanBound = 2e-5;
 double atanUnit(double z) {
     const double z2 = z * z;
-    return z * (0.9998660 + z2 * (-0.3302995 + z2 * (0.1801410 + z2 * (-0.0851330 + z2 * 0.0208351))));
+    return z *
+           (0.9998660 + z2 * (-0.3302995 + z2 * (0.1801410 + z2 * (-0.0851330 + z2 * 0.0208351))));
 }
 } // namespace
 

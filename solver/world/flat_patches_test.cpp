@@ -281,9 +281,9 @@ TEST_CASE("flat patches: the cones' angle bound lies above the true angle, withi
         check(a, b);
         const double t = std::ldexp(1.0, -(k % 40)); // 1 … 2⁻³⁹ rad off
         const Vec3 u = a.normalized(), w = a.cross(b).normalized().cross(u);
-        check(u, std::cos(t) * u + std::sin(t) * w);                     // near parallel
-        check(u, -std::cos(t) * u + std::sin(t) * w);                    // near opposite
-        check(u, std::sin(t) * u + std::cos(t) * w);                     // near orthogonal
+        check(u, std::cos(t) * u + std::sin(t) * w);                             // near parallel
+        check(u, -std::cos(t) * u + std::sin(t) * w);                            // near opposite
+        check(u, std::sin(t) * u + std::cos(t) * w);                             // near orthogonal
         check(u, std::cos(0.25 * M_PI + t) * u + std::sin(0.25 * M_PI + t) * w); // at the seam
     }
     check(Vec3::Zero(), Vec3::UnitX());
