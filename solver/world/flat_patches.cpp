@@ -34,8 +34,9 @@ double quadraticMinimum(double b0, double b1, double b2) {
 }
 
 // The arctangent's polynomial (Abramowitz & Stegun 4.4.49) is within 1.15e-5 rad of atan z on
-// [0, 1] with these coefficients (checked on a 2·10⁵-point grid, flat_patches_test.cpp); the
-// angles below add kAtanBound so that they bound the true angle from above, as the cones need.
+// [0, 1] with these coefficients (measured on a 2·10⁵-point grid); the angles below add
+// kAtanBound so that they bound the true angle from above, as the cones need
+// (flat_patches_test.cpp checks the bound against atan2).
 constexpr double kAtanBound = 2e-5;
 double atanUnit(double z) {
     const double z2 = z * z;
@@ -45,8 +46,8 @@ double atanUnit(double z) {
 } // namespace
 
 double angleUpperBound(const Vec3& a, const Vec3& b) {
-    // atan2(|a × b|, a·b) ∈ [0, π] + kAtanBound, by octant, without libm's atan2 (the cones'
-    // cost on a flapping cape was a fifth in it).
+    // atan2(|a × b|, a·b) ∈ [0, π] + kAtanBound, by octant, without libm's atan2 (about half
+    // the cones' time on the cape benchmark was in it).
     const double y = a.cross(b).norm(), x = a.dot(b), ax = std::abs(x);
     if (!(std::max(y, ax) > 0.0)) return kAtanBound;
     const double base =

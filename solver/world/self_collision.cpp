@@ -636,8 +636,8 @@ int SelfCollision::proximity() {
                 // Early out: the boxes' distance g ≤ d₁, so g − l > ξ (with a margin far above
                 // the rounding of either distance) means d₁ − l > ξ > ξ_c: no contact and
                 // nothing for CCD — what the exact distance below would decide.
-                // A vertex–triangle pair with a held side (a pin, an attachment) is looked at out
-                // to planeReach × ξ as well (the near pairs below).
+                // A vertex–triangle pair with a held side (a pinned or rigidly attached vertex)
+                // is looked at out to planeReach × ξ as well (the near pairs below).
                 bool heldSide = false;
                 for (int k = 0; k < 4 && vt; ++k) heldSide = heldSide || mInvMass[p.v[k]] == 0.0;
                 const double reach = heldSide ? std::max(xi, mSettings.planeReach * xi) : xi;

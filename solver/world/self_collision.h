@@ -45,11 +45,11 @@ struct SelfCollisionSettings {
     // The broad phase skips pairs inside certified flat patches of cloth (flat_patches.h): the
     // same pairs are corrected either way, found with less work.
     bool flatPatches = true;
-    // Vertex–triangle pairs with a held side (a pinned or attached vertex) closer than this × ξ
-    // at the end of a pass, not only those within ξ, hold their free side in the next step's
-    // solve (contactPlanes): cloth pressed against its own pinned collar is stopped at ξ there,
-    // instead of crossing into it and being pushed back by the next pass, which can move only
-    // the free side and stretches the cloth round it. ≤ 1: the pairs within ξ only.
+    // Vertex–triangle pairs with a held side (a pinned or rigidly attached vertex) closer than
+    // this × ξ at the end of a pass, not only those within ξ, hold their free side in the next
+    // step's solve (contactPlanes): cloth pressed against its own pinned collar is stopped at ξ
+    // there, instead of crossing into it and being pushed back by the next pass, which can move
+    // only the free side and stretches the cloth round it. ≤ 1: the pairs within ξ only.
     double planeReach = 1.5;
 };
 
