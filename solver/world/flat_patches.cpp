@@ -51,7 +51,7 @@ double angleUpperBound(const Vec3& a, const Vec3& b) {
     const double y = a.cross(b).norm(), x = a.dot(b), ax = std::abs(x);
     if (!(std::max(y, ax) > 0.0)) return kAtanBound;
     const double base =
-        y <= ax ? atanUnit(y / ax) : 0.5 * kPi - atanUnit(ax / y); // the angle from ±a's line
+        y <= ax ? atanUnit(y / ax) : kHalfPi - atanUnit(ax / y); // the angle from ±a's line
     return (x >= 0.0 ? base : kPi - base) + kAtanBound;
 }
 

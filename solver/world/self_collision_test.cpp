@@ -564,7 +564,7 @@ TEST_CASE("self-collision: cloth pressed against pinned cloth is held in its sol
     // A free 0.4 m sheet (16 × 16) lying 1.2 ξ above a 0.6 m sheet pinned everywhere (a table of
     // cloth), in gravity, one substep a frame (the cape pressed against its own pinned collar).
     // The pass can move only the free side of a pair with the table; held in the solve from
-    // 1.5 ξ (WorldSettings::clothPlaneReach) instead of from ξ, the sheet is stopped at ξ by its
+    // 1.5 ξ (SelfCollisionSettings::planeReach) instead of from ξ, the sheet is stopped at ξ by its
     // solve rather than falling into ξ and being pushed back by the pass: the pass's proximity
     // pairs and CCD hits fall, no more intervals are solved again or halved, the sheet
     // stretches no more, and nothing intersects either way.
@@ -576,7 +576,7 @@ TEST_CASE("self-collision: cloth pressed against pinned cloth is held in its sol
     const auto run = [](double reach) {
         WorldSettings ws;
         ws.substeps = 1;
-        ws.clothPlaneReach = reach;
+        ws.selfCollision.planeReach = reach;
         World w(ws);
         ClothMaterial m;
         m.lift.value = gale::fields::Param(0.0);

@@ -70,9 +70,7 @@ FrameStats World::advance(double t0, double dt, int substeps) {
 
 void World::setUpSelfCollision(FrameStats& fs) {
     mSelfSetUp = true;
-    SelfCollisionSettings selfSettings;
-    selfSettings.planeReach = mSettings.clothPlaneReach;
-    auto self = std::make_unique<SelfCollision>(selfSettings);
+    auto self = std::make_unique<SelfCollision>(mSettings.selfCollision);
     for (size_t b = 0; b < mBodies.size(); ++b) {
         Body& body = *mBodies[b];
         const auto* tris = body.collisionTriangles();

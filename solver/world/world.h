@@ -53,9 +53,9 @@ struct WorldSettings {
     // (SelfCollision::contactPlanes, Body::setClothPlanes), so that the pass after the solve
     // has little left to push. Off: the pass alone (measured against it).
     bool clothContactInSolve = true;
-    // With clothContactInSolve: vertex–triangle pairs with a pinned side are held from this ×
-    // the thickness (SelfCollisionSettings::planeReach; ≤ 1: only those within the thickness).
-    double clothPlaneReach = 1.5;
+    // The self-collision pass's own settings (self_collision.h; with clothContactInSolve, its
+    // planeReach: how far from a pinned side a pair is held in the solve).
+    SelfCollisionSettings selfCollision;
 };
 
 // Per body, per frame.
