@@ -160,6 +160,9 @@ void Body::restore(const Snapshot& s) {
     mV = s.v;
     mDvGuess = s.dvGuess;
     mHGuess = s.hGuess;
+    mSlidRate = s.slidRate;
+    mSlipMass = s.slipMass;
+    mSlidOn = s.slidOn;
 }
 
 double Body::kineticEnergy() const {
@@ -356,6 +359,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         applyClothPlanes(t, h);
         return;
     }
+    bool warm = false; // a contact starts with the friction it slid with (syncFriction below)
+    if (mSlipMass.size() != n) mSlipMass.assign(n, 0.0);
     for (size_t ci = 0; ci < mKin.colliders.size(); ++ci) {
         const Collider& c = (*env.colliders)[ci];
         const double thick = mKin.colliders[ci].thickness;
@@ -390,6 +395,19 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
                        c.friction > 0.0);
             mContactMu[i] = c.friction;
             mContactImpulse[i] = -un;
+            // Sliding on this collider at the last substep's end: it starts sliding, with the
+            // friction it ended with (the secant rounds then start near their answer, not
+            // from a stick and a frictionless slide).
+            if (c.friction > 0.0 && i < mSlidOn.size() && mSlidOn[i] == static_cast<int>(ci)) {
+                const Vec3 nrm = cp.normal;
+                Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
+                mConstraints.kind[i] = 2;
+                z = nrm * z.dot(nrm);
+                mFrictionDamping[i] = mSlidRate[i] * h;
+                warm = true;
+            } else {
+                mSlipMass[i] = 0.0;
+            }
         }
         // A moving mesh's vertices against this cloth's triangles: a body vertex within the
         // band of a triangle, its nearest point q = Σ w_k x_k moving in, gives each corner that
@@ -441,6 +459,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         }
     }
     applyClothPlanes(t, h);
+    if (warm) syncFriction(mV, true);
 }
 
 // Cloth against cloth in the solve (World, WorldSettings::clothContactInSolve): a free vertex
@@ -603,10 +622,18 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             // (c, slip) and the previous one's: c with c·slip(c) = μ λ_n (Aitken's step; the
             // plain lag converges only by the factor μ λ_n / p a solve).
             const double cPrev = mFrictionPrev[2 * i], sPrev = mFrictionPrev[2 * i + 1];
+            double m = 0.0;
             if (sPrev > slipN * (1.0 + 1e-6) && now > cPrev) {
-                const double m = (now * slipN - cPrev * sPrev) / (sPrev - slipN);
+                m = (now * slipN - cPrev * sPrev) / (sPrev - slipN);
+                if (m > 0.0) mSlipMass[i] = m;
+            } else if (sPrev == 0.0 && now > 0.0) {
+                // The first solve of a contact that started sliding with the friction it slid
+                // with (contactConstraints): one point, the response's mass carried with it.
+                m = mSlipMass[i];
+            }
+            if (m > 0.0) {
                 const double p = slipN * (m + now);
-                if (m > 0.0) next = p > bound ? bound * m / (p - bound) : bound / kSlipFloor;
+                next = p > bound ? bound * m / (p - bound) : bound / kSlipFloor;
             }
             mFrictionPrev[2 * i] = now;
             mFrictionPrev[2 * i + 1] = slipN;
@@ -1301,6 +1328,20 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             ls.iterations += before;
             ls.residual = std::max(ls.residual, res);
             ++st.contactSolves;
+        }
+        // What slid, and with what friction, for the next substep's start.
+        mSlidOn.assign(n, -1);
+        mSlidRate.assign(n, 0.0);
+        for (size_t i = 0; i < n; ++i) {
+            if (mContactCollider[i] < 0 || mConstraints.kind[i] != 2 || !(mContactMu[i] > 0.0) ||
+                !(mFrictionDamping[i] > 0.0))
+                continue;
+            const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+            const Vec3 rel =
+                vec3At(v0.data(), i) + vec3At(mDv.data(), i) - vec3At(mContactVelocity.data(), i);
+            if (!((rel - nrm * rel.dot(nrm)).norm() > 2.0 * kSlipFloor)) continue;
+            mSlidOn[i] = mContactCollider[i];
+            mSlidRate[i] = mFrictionDamping[i] / h;
         }
         syncFriction(v0, false); // A as assembled again (Newton, the next rounds' callers)
     }

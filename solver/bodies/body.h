@@ -279,8 +279,10 @@ public:
     struct Snapshot {
         VecX x, v, dvGuess;
         double hGuess = 0.0;
+        std::vector<double> slidRate, slipMass; // sliding contacts (mSlidRate, mSlipMass, mSlidOn)
+        std::vector<int> slidOn;
     };
-    Snapshot snapshot() const { return {mX, mV, mDvGuess, mHGuess}; }
+    Snapshot snapshot() const { return {mX, mV, mDvGuess, mHGuess, mSlidRate, mSlipMass, mSlidOn}; }
     void restore(const Snapshot& s);
 
     // The last line of defence at the smallest substep (World): from the state a troubled
@@ -424,6 +426,14 @@ private:
     std::vector<int> mNearTriangle;
     std::vector<double> mFrictionDamping; // per vertex: a sliding contact's friction c (kg)
     std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
+    // Per vertex, from the last substep's end: a contact that slid (slip above 2 ε_v) on
+    // collider mSlidOn[i] with friction c = mSlidRate[i] · h (kg; c/h in kg/s), so that the
+    // next substep starts it sliding with that friction (contactConstraints).
+    std::vector<double> mSlidRate;
+    std::vector<int> mSlidOn;
+    // Per vertex: the effective mass (kg) of a sliding contact's slip response, m in
+    // slip = p / (m + c), from the secant (updateContacts); carried with mSlidRate.
+    std::vector<double> mSlipMass;
     std::vector<double> mFrictionInA;     // per vertex: the c now added to A (kg) ...
     VecX mFrictionAxis;                   // ... about this normal (3 per vertex)
     VecX mYPos; // 3 per vertex: the position alteration y of the contacts (x₁ = x₀ + h v₁ + y)
