@@ -345,6 +345,7 @@ private:
     // surface-velocity part into mFriction; `keep` false takes it out of A again.
     void syncFriction(const VecX& v0, bool keep);
     void landed();
+    void rememberSliding(const VecX& v0, double h);
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
