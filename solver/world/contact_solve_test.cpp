@@ -1,4 +1,4 @@
-// Collider contact inside the implicit step (body.cpp, contact constraints): a sheet dropped
+// Collider contact inside the implicit step (body_contact.cpp, contact constraints): a sheet dropped
 // flat onto a sphere and edge-first onto the ground at one substep per frame against the same
 // scene at sixteen (stretch, kinetic energy after the impact, no halving, nothing left for the
 // projection after the solve), and a sheet at rest on the floor that loses energy every frame.
