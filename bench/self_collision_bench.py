@@ -10,7 +10,7 @@
 # wall and user CPU seconds of the process (the machine is shared: CPU seconds scatter less).
 #   bench/self_collision_bench.py [--build build] [--repeats 1] [--quick] [--only cape|fold]
 #                                 [--baseline /work/main/build]
-#   bench/self_collision_bench.py --only gusts [--strengths 20,22,...] [--threads 1]
+#   bench/self_collision_bench.py --only gusts [--strengths 20,22,...] [--threads 1] [--no-count]
 #     (the cape at several gust strengths: one trajectory is chaotic, their sum is fairer)
 import argparse
 import json
@@ -164,7 +164,7 @@ def gusts(args, work):
                 t[k] += v
             print("| %s | %g | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f× | %d | %d | %d |"
                   % (label, strength, offCpu, onCpu, onCpu / offCpu, off, on, on / off, halved,
-                     again, pairs(out)), flush=True)
+                     again, -1 if args.no_count else pairs(out)), flush=True)
     for label, _ in builds:
         t = total[label]
         print("| %s | all | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %d | %d | |"
@@ -199,6 +199,8 @@ def main():
     ap.add_argument("--strengths", default="20,22,24,25,26,28,30",
                     help="--only gusts: the gust strengths (m/s) of the cape")
     ap.add_argument("--threads", type=int, default=1, help="--only gusts: threads")
+    ap.add_argument("--no-count", action="store_true",
+                    help="--only gusts: skip counting the on runs' intersecting pairs (the slow part)")
     ap.add_argument("--baseline", help="another build folder whose gale runs alternately")
     ap.add_argument("--distance-step", type=int, default=4,
                     help="minimum distance on every N-th frame (it costs ~1 s a frame)")
