@@ -501,8 +501,11 @@ struct Reader {
 };
 } // namespace
 
+// GALESTATE2: per body its name, x, v, the warm start (Δv, h) and the sliding contacts' friction
+// carried to the next substep (rate, response mass, collider index + 1); GALESTATE1 (no carry)
+// is read as well.
 std::string World::saveState() const {
-    std::string s = "GALESTATE1";
+    std::string s = "GALESTATE2";
     putU64(s, mBodies.size());
     for (const auto& b : mBodies) {
         putU64(s, b->name().size());
@@ -513,12 +516,23 @@ std::string World::saveState() const {
         putVec(s, snap.dvGuess);
         double h = snap.hGuess;
         s.append(reinterpret_cast<const char*>(&h), sizeof h);
+        const auto toVec = [](const auto& a) {
+            VecX v(static_cast<long>(a.size()));
+            for (size_t k = 0; k < a.size(); ++k) v[static_cast<long>(k)] = double(a[k]);
+            return v;
+        };
+        putVec(s, toVec(snap.slidRate));
+        putVec(s, toVec(snap.slipMass));
+        VecX on = toVec(snap.slidOn);
+        on.array() += 1.0; // −1 (none) as 0
+        putVec(s, on);
     }
     return s;
 }
 
 bool World::loadState(const std::string& bytes, std::string& error) {
-    if (bytes.compare(0, 10, "GALESTATE1") != 0) {
+    const bool carry = bytes.compare(0, 10, "GALESTATE2") == 0;
+    if (!carry && bytes.compare(0, 10, "GALESTATE1") != 0) {
         error = "not a gale solver state (bad header)";
         return false;
     }
@@ -549,6 +563,23 @@ bool World::loadState(const std::string& bytes, std::string& error) {
         if (r.ok) {
             std::memcpy(&snaps[i].hGuess, bytes.data() + r.pos, sizeof(double));
             r.pos += sizeof(double);
+        }
+        if (carry) {
+            const VecX rate = r.vec(), mass = r.vec(), on = r.vec();
+            const size_t n = mBodies[i]->vertexCount();
+            const auto sized = [&](const VecX& v) {
+                return v.size() == 0 || size_t(v.size()) == n;
+            };
+            if (!r.ok || !sized(rate) || !sized(mass) || !sized(on)) {
+                error = "the state of '" + name + "' has a broken contact record";
+                return false;
+            }
+            snaps[i].slidRate.assign(rate.data(), rate.data() + rate.size());
+            snaps[i].slipMass.assign(mass.data(), mass.data() + mass.size());
+            snaps[i].slidOn.resize(static_cast<size_t>(on.size()));
+            for (long k = 0; k < on.size(); ++k)
+                snaps[i].slidOn[static_cast<size_t>(k)] =
+                    on[k] >= 1.0 && on[k] < 1e6 ? static_cast<int>(std::lround(on[k])) - 1 : -1;
         }
         const long n3 = static_cast<long>(3 * mBodies[i]->vertexCount());
         if (!r.ok || snaps[i].x.size() != n3 || snaps[i].v.size() != n3) {
