@@ -140,7 +140,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             // Sliding on this collider at the last substep's end: it starts sliding, with the
             // friction it ended with (the secant rounds then start near their answer, not
             // from a stick and a frictionless slide).
-            if (c.friction > 0.0 && i < mSlidOn.size() && mSlidOn[i] == static_cast<int>(ci)) {
+            if (c.friction > 0.0 && i < mSlidOn.size() && i < mSlidRate.size() &&
+                mSlidOn[i] == static_cast<int>(ci)) {
                 const Vec3 nrm = cp.normal;
                 Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
                 mConstraints.kind[i] = 2;

@@ -570,7 +570,7 @@ bool World::loadState(const std::string& bytes, std::string& error) {
             const auto sized = [&](const VecX& v) {
                 return v.size() == 0 || size_t(v.size()) == n;
             };
-            if (!r.ok || !sized(rate) || rate.size() != mass.size() || rate.size() != on.size()) {
+            if (!r.ok || !sized(rate) || !sized(mass) || !sized(on)) {
                 error = "the state of '" + name + "' has a broken contact record";
                 return false;
             }
