@@ -141,6 +141,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             // friction it ended with (the secant rounds then start near their answer, not
             // from a stick and a frictionless slide).
             if (c.friction > 0.0 && i < mSlidOn.size() && i < mSlidRate.size() &&
+                mSlidRate[i] > 0.0 && std::isfinite(mSlidRate[i]) &&
                 mSlidOn[i] == static_cast<int>(ci)) {
                 const Vec3 nrm = cp.normal;
                 Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
