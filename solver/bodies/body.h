@@ -346,6 +346,8 @@ private:
     void syncFriction(const VecX& v0, bool keep);
     void landed();
     void rememberSliding(const VecX& v0, double h);
+    void slide(size_t i, double c);
+    double slipOf(size_t i, const VecX& v0) const;
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
@@ -429,7 +431,8 @@ private:
     std::vector<double> mFrictionPrev;    // per vertex: the previous solve's c and slip (secant)
     // Per vertex, from the last substep's end: a contact that slid (slip above 2 ε_v) on
     // collider mSlidOn[i] with friction c = mSlidRate[i] · h (kg; c/h in kg/s), so that the
-    // next substep starts it sliding with that friction (contactConstraints).
+    // next substep starts it sliding with that friction (contactConstraints). Empty when
+    // nothing slid.
     std::vector<double> mSlidRate;
     std::vector<int> mSlidOn;
     // Per vertex: the effective mass (kg) of a sliding contact's slip response, m in

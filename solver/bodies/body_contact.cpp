@@ -143,11 +143,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             if (c.friction > 0.0 && i < mSlidOn.size() && i < mSlidRate.size() &&
                 mSlidRate[i] > 0.0 && std::isfinite(mSlidRate[i]) &&
                 mSlidOn[i] == static_cast<int>(ci)) {
-                const Vec3 nrm = cp.normal;
-                Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
-                mConstraints.kind[i] = 2;
-                z = nrm * z.dot(nrm);
-                mFrictionDamping[i] = mSlidRate[i] * h;
+                slide(i, mSlidRate[i] * h);
                 warm = true;
             } else {
                 mSlipMass[i] = 0.0;
@@ -347,17 +343,12 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                 // and the lagged c = μ λ_n / |v_t| then converges from above (each further
                 // solve slows the slip towards Coulomb's; from below, from a resting slip of
                 // ε_v, the slip would grow only by tan θ / μ a solve).
-                mConstraints.kind[i] = 2;
-                z = nrm * z.dot(nrm);
-                mFrictionDamping[i] = 0.0;
-                mFrictionPrev[2 * i] = mFrictionPrev[2 * i + 1] = 0.0;
+                slide(i, 0.0);
                 ++st.contactSlides;
                 ++changes;
             }
         } else if (mu > 0.0) { // sliding: c from this solve's normal impulse and slip
-            const Vec3 rel =
-                vec3At(v0.data(), i) + vec3At(mDv.data(), i) - vec3At(mContactVelocity.data(), i);
-            const double slipN = std::max((rel - nrm * rel.dot(nrm)).norm(), kSlipFloor);
+            const double slipN = std::max(slipOf(i, v0), kSlipFloor);
             const double bound = std::max(mu * ln, 0.0); // Coulomb's impulse (N·s)
             const double now = mFrictionDamping[i];
             double next = bound / slipN; // Picard: the lagged c
@@ -507,22 +498,42 @@ int Body::resolveContacts(const Environment& env, double h, SubstepStatus& st) {
 
 // What slid at the end of the substep's solves (slip above 2 ε_v relative to the surface), on
 // which collider and with what friction c/h: the next substep starts it sliding with it
-// (contactConstraints).
+// (contactConstraints). Empty when nothing slid (nothing to copy into snapshots).
 void Body::rememberSliding(const VecX& v0, double h) {
     const size_t n = vertexCount();
-    mSlidOn.assign(n, -1);
-    mSlidRate.assign(n, 0.0);
+    mSlidOn.clear();
+    mSlidRate.clear();
     for (size_t i = 0; i < n; ++i) {
         if (mContactCollider[i] < 0 || mConstraints.kind[i] != 2 || !(mContactMu[i] > 0.0) ||
-            !(mFrictionDamping[i] > 0.0))
+            !(mFrictionDamping[i] > 0.0) || !(slipOf(i, v0) > 2.0 * kSlipFloor))
             continue;
-        const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
-        const Vec3 rel =
-            vec3At(v0.data(), i) + vec3At(mDv.data(), i) - vec3At(mContactVelocity.data(), i);
-        if (!((rel - nrm * rel.dot(nrm)).norm() > 2.0 * kSlipFloor)) continue;
+        if (mSlidOn.empty()) {
+            mSlidOn.assign(n, -1);
+            mSlidRate.assign(n, 0.0);
+        }
         mSlidOn[i] = mContactCollider[i];
         mSlidRate[i] = mFrictionDamping[i] / h;
     }
+}
+
+// A contact turns to sliding (S = I − nnᵀ, the prescribed change kept along the normal only)
+// with friction c (kg; the secant starts afresh).
+void Body::slide(size_t i, double c) {
+    const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+    Eigen::Map<Vec3> z(mConstraints.z.data() + 3 * i);
+    mConstraints.kind[i] = 2;
+    z = nrm * z.dot(nrm);
+    mFrictionDamping[i] = c;
+    mFrictionPrev[2 * i] = mFrictionPrev[2 * i + 1] = 0.0;
+}
+
+// m/s: vertex i's slip at the end of the last solve, its velocity relative to its contact's
+// surface in the contact plane.
+double Body::slipOf(size_t i, const VecX& v0) const {
+    const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+    const Vec3 rel =
+        vec3At(v0.data(), i) + vec3At(mDv.data(), i) - vec3At(mContactVelocity.data(), i);
+    return (rel - nrm * rel.dot(nrm)).norm();
 }
 
 } // namespace gale::solver

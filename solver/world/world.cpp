@@ -502,8 +502,8 @@ struct Reader {
 } // namespace
 
 // GALESTATE2: per body its name, x, v, the warm start (Δv, h) and the sliding contacts' friction
-// carried to the next substep (rate, response mass, collider index + 1); GALESTATE1 (no carry)
-// is read as well.
+// carried to the next substep (rate, response mass, collider index or −1; empty when nothing
+// slid); GALESTATE1 (no carry) is read as well.
 std::string World::saveState() const {
     std::string s = "GALESTATE2";
     putU64(s, mBodies.size());
@@ -523,9 +523,7 @@ std::string World::saveState() const {
         };
         putVec(s, toVec(snap.slidRate));
         putVec(s, toVec(snap.slipMass));
-        VecX on = toVec(snap.slidOn);
-        on.array() += 1.0; // −1 (none) as 0
-        putVec(s, on);
+        putVec(s, toVec(snap.slidOn));
     }
     return s;
 }
@@ -579,7 +577,7 @@ bool World::loadState(const std::string& bytes, std::string& error) {
             snaps[i].slidOn.resize(static_cast<size_t>(on.size()));
             for (long k = 0; k < on.size(); ++k)
                 snaps[i].slidOn[static_cast<size_t>(k)] =
-                    on[k] >= 1.0 && on[k] < 1e6 ? static_cast<int>(std::lround(on[k])) - 1 : -1;
+                    on[k] >= 0.0 && on[k] < 1e6 ? static_cast<int>(std::lround(on[k])) : -1;
         }
         const long n3 = static_cast<long>(3 * mBodies[i]->vertexCount());
         if (!r.ok || snaps[i].x.size() != n3 || snaps[i].v.size() != n3) {
