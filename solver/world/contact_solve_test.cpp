@@ -4,6 +4,7 @@
 // projection after the solve), and a sheet at rest on the floor that loses energy every frame.
 #include "solver/bodies/cloth.h"
 #include "solver/collider/collider.h"
+#include "solver/world/test_support.h"
 #include "solver/world/world.h"
 
 #include <catch2/catch.hpp>
@@ -13,6 +14,7 @@
 #include <cstdlib>
 
 using namespace gale::solver;
+using namespace gale::solver::testing;
 using gale::fields::Param;
 
 namespace {
@@ -198,22 +200,8 @@ TEST_CASE("contact in the solve: Coulomb friction on an incline at one substep p
         const Vec3 normal(-std::sin(theta), std::cos(theta), 0.0);
         const Vec3 down(-std::cos(theta), -std::sin(theta), 0.0); // along the slope, downhill
         for (double mu : {0.2, 0.3, 0.5}) {
-            Collider plane;
-            plane.a = Param(std::vector<double>{0, 0, 0});
-            plane.normal = Param(std::vector<double>{normal.x(), normal.y(), normal.z()});
-            plane.friction = mu;
-            plane.thickness = 0.0;
-            TriMesh mesh = makeGrid(0.1, 0.1, 5, 5, Vec3::Zero(), -down, Vec3::UnitZ());
-            ClothMaterial m;
-            m.lift.value = Param(0.0);
-            m.drag.value = Param(0.0);
-            m.stretch = Param(1e4);
-            WorldSettings ws;
-            ws.gravity = Vec3(0, -g, 0);
-            ws.substeps = 1;
-            World w(ws);
-            w.addBody(std::make_unique<Cloth>("patch", mesh, m));
-            w.addCollider(plane);
+            const auto world = inclineWorld(thetaDeg, mu, g);
+            World& w = *world;
             int rejected = 0;
             for (int f = 1; f <= 24; ++f) {
                 const BodyFrameStats b = w.advanceFrame(f).bodies[0];
@@ -227,10 +215,12 @@ TEST_CASE("contact in the solve: Coulomb friction on an incline at one substep p
             const VecX& x = w.bodies()[0]->positions();
             const VecX& v = w.bodies()[0]->velocities();
             Vec3 c = Vec3::Zero(), c0 = Vec3::Zero(), vc = Vec3::Zero();
-            for (size_t i = 0; i < mesh.vertexCount(); ++i) {
-                c += vec3At(x.data(), i) / double(mesh.vertexCount());
-                c0 += mesh.position(i) / double(mesh.vertexCount());
-                vc += vec3At(v.data(), i) / double(mesh.vertexCount());
+            const VecX& x0 = w.bodies()[0]->restPositions();
+            const size_t count = w.bodies()[0]->vertexCount();
+            for (size_t i = 0; i < count; ++i) {
+                c += vec3At(x.data(), i) / double(count);
+                c0 += vec3At(x0.data(), i) / double(count);
+                vc += vec3At(v.data(), i) / double(count);
             }
             // The acceleration from the speed at T (backward Euler under a constant force gives
             // v = a T exactly; its distance is ½ a T² (1 + h/T)).

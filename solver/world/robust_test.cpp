@@ -138,27 +138,7 @@ TEST_CASE("robust: saving and loading the state continues bit for bit", "[robust
     // A patch sliding down a 30° incline with friction μ = 0.2: its contacts start each substep
     // sliding with the friction they ended the last with (body_contact.cpp), which the state
     // carries too.
-    auto makeIncline = [] {
-        const double theta = 30.0 * M_PI / 180.0;
-        const Vec3 normal(-std::sin(theta), std::cos(theta), 0.0);
-        const Vec3 down(-std::cos(theta), -std::sin(theta), 0.0);
-        Collider plane;
-        plane.a = Param(std::vector<double>{0, 0, 0});
-        plane.normal = Param(std::vector<double>{normal.x(), normal.y(), normal.z()});
-        plane.friction = 0.2;
-        plane.thickness = 0.0;
-        ClothMaterial m;
-        m.lift.value = Param(0.0);
-        m.drag.value = Param(0.0);
-        m.stretch = Param(1e4);
-        WorldSettings ws;
-        ws.substeps = 1;
-        auto w = std::make_unique<World>(ws);
-        w->addBody(std::make_unique<Cloth>(
-            "patch", makeGrid(0.1, 0.1, 5, 5, Vec3::Zero(), -down, Vec3::UnitZ()), m));
-        w->addCollider(plane);
-        return w;
-    };
+    const auto makeIncline = [] { return inclineWorld(30.0, 0.2); };
     auto slid = makeIncline();
     for (int f = 1; f <= 12; ++f) REQUIRE_FALSE(slid->advanceFrame(f).failed);
     auto half = makeIncline();

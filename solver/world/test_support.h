@@ -57,6 +57,32 @@ inline std::vector<int> gridRow(int nx, int j) {
     return out;
 }
 
+// A 10 cm patch (5 × 5 vertices, 1e4 N/m, no aerodynamics) lying on a plane through the origin
+// tilted by θ about z (normal (−sin θ, cos θ, 0)), the plane's friction μ and no thickness, one
+// substep a frame, gravity g along −y.
+inline std::unique_ptr<World> inclineWorld(double thetaDeg, double mu, double g = 9.81) {
+    const double theta = thetaDeg * M_PI / 180.0;
+    const Vec3 normal(-std::sin(theta), std::cos(theta), 0.0);
+    const Vec3 down(-std::cos(theta), -std::sin(theta), 0.0); // along the slope, downhill
+    Collider plane;
+    plane.a = fields::Param(std::vector<double>{0, 0, 0});
+    plane.normal = fields::Param(std::vector<double>{normal.x(), normal.y(), normal.z()});
+    plane.friction = mu;
+    plane.thickness = 0.0;
+    ClothMaterial m;
+    m.lift.value = fields::Param(0.0);
+    m.drag.value = fields::Param(0.0);
+    m.stretch = fields::Param(1e4);
+    WorldSettings ws;
+    ws.gravity = Vec3(0, -g, 0);
+    ws.substeps = 1;
+    auto w = std::make_unique<World>(ws);
+    w->addBody(std::make_unique<Cloth>(
+        "patch", makeGrid(0.1, 0.1, 5, 5, Vec3::Zero(), -down, Vec3::UnitZ()), m));
+    w->addCollider(plane);
+    return w;
+}
+
 inline bool allFinite(const VecX& v) { return v.allFinite(); }
 
 } // namespace gale::solver::testing
