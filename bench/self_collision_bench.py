@@ -162,9 +162,9 @@ def gusts(args, work):
             t = total[label]
             for k, v in enumerate((offCpu, onCpu, off, on, halved, again)):
                 t[k] += v
-            print("| %s | %g | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f× | %d | %d | %d |"
+            print("| %s | %g | %.2f | %.2f | **%.2f×** | %.2f | %.2f | %.2f× | %d | %d | %s |"
                   % (label, strength, offCpu, onCpu, onCpu / offCpu, off, on, on / off, halved,
-                     again, -1 if args.no_count else pairs(out)), flush=True)
+                     again, "–" if args.no_count else pairs(out)), flush=True)
     for label, _ in builds:
         t = total[label]
         print("| %s | all | %.2f | %.2f | **%.2f×** | %.2f | %.2f | **%.2f×** | %d | %d | |"
