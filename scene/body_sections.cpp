@@ -51,7 +51,8 @@ const std::vector<std::string> kColliderKeys = {
     "b",    "thickness", "friction", "mesh",   "voxel", "rest_mesh"};
 const std::vector<std::string> kSolverKeys = {
     "max_halvings",      "over_stretch", "velocity_jump", "retry_newton",      "retry_cg_tolerance",
-    "retry_keep_coarse", "retry_repeat", "grow_back",     "retry_strain_limit"};
+    "retry_keep_coarse", "retry_repeat", "grow_back",     "retry_strain_limit",
+    "rotation_projection"};
 
 class Loader : public TomlReader {
 public:
@@ -697,6 +698,8 @@ void Loader::loadSolver(const toml::table& t, SolverSection& s) {
     if (const toml::node* n = t.get("grow_back")) boolean(*n, "[solver] grow_back", s.growBack);
     if (const toml::node* n = t.get("retry_strain_limit"))
         boolean(*n, "[solver] retry_strain_limit", s.strainLimit);
+    if (const toml::node* n = t.get("rotation_projection"))
+        boolean(*n, "[solver] rotation_projection", s.rotationProjection);
 }
 
 void Loader::load(const toml::table& root, const std::string& baseDir, SimScene& out) {

@@ -239,9 +239,11 @@ retry_keep_coarse = true
 retry_repeat = true
 grow_back = true
 retry_strain_limit = true
+rotation_projection = true
 )");
     INFO(ok.all());
     REQUIRE(ok.ok);
+    CHECK(ok.scene.solver.rotationProjection);
     CHECK(ok.scene.solver.retryNewton == 2);
     CHECK(ok.scene.solver.retryCgTolerance == 0.05);
     CHECK(ok.scene.solver.retryKeepCoarse);

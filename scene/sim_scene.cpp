@@ -390,6 +390,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         cloth->options() = spec.step;
         cloth->collision() = spec.collision;
         cloth->limits().overStretch = scene.solver.overStretch;
+        cloth->options().rotationProjection = scene.solver.rotationProjection;
         cloth->limits().velocityJump = scene.solver.velocityJump;
         if (cloth->degenerateTriangles())
             warnings.push_back(what + ": " + std::to_string(cloth->degenerateTriangles()) +
@@ -514,6 +515,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         hair->options() = spec.step;
         hair->collision().self = spec.collideCloth;
         hair->limits().overStretch = scene.solver.overStretch;
+        hair->options().rotationProjection = scene.solver.rotationProjection;
         hair->limits().velocityJump = scene.solver.velocityJump;
         bodies.push_back(std::move(hair));
     }

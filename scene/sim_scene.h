@@ -108,6 +108,9 @@ struct SolverSection {
     bool retryRepeat = solver::WorldSettings{}.retryRepeat;
     bool growBack = solver::WorldSettings{}.growBack;
     bool strainLimit = false;
+    // Every body's linearised step has the length its rotations add projected out
+    // (solver::StepOptions::rotationProjection).
+    bool rotationProjection = false;
 };
 
 struct SimScene {

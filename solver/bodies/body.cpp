@@ -8,6 +8,7 @@
 // same matrix re-evaluated at the iterate (body_newton.cpp). The wind is sampled once per
 // substep, at x₀.
 #include "solver/bodies/body.h"
+#include "solver/bodies/rotation_projection.h"
 #include "solver/collider/moving_collider.h"
 #include "solver/mesh/mesh_sequence.h"
 
@@ -601,6 +602,11 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
             mNewtonKeepCoarse = false;
         }
     }
+    // 5b. ... else the length the linearised step's rotations added, projected out
+    // (rotation_projection.h).
+    if (st.converged && !mOptions.explicitEuler && mOptions.rotationProjection &&
+        st.newtonIterations == 0)
+        projectRotations(x0, v0, h, st);
     mDvGuess = mDv;
     mHGuess = h;
     mV = v0 + mDv;
@@ -668,6 +674,60 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         }
     }
     return st;
+}
+
+// The rotation-length projection of the linearised step (rotation_projection.h). A free vertex
+// that ends the step within a collider's thickness plus kHoldMargin of it moves only along that
+// collider's surface (its tangent plane there), and afterwards back out to the distance it had
+// where a curved surface came closer: the projection leaves the push-out after the solve
+// nothing to do.
+void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st) {
+    constexpr double kHoldMargin = 0.01; // m
+    const auto endOf = [&](size_t v) {
+        return Vec3(vec3At(x0.data(), v) + h * (vec3At(v0.data(), v) + vec3At(mDv.data(), v)) +
+                    vec3At(mYPos.data(), v));
+    };
+    const auto hold = [&](int i) {
+        const size_t v = static_cast<size_t>(i);
+        const Vec3 x1 = endOf(v);
+        Vec3 normal = Vec3::Zero();
+        double nearest = INFINITY;
+        for (size_t k = 0; k < mKin.colliders.size(); ++k) {
+            const double reach = mKin.colliders[k].thickness + kHoldMargin;
+            ContactPoint cp;
+            if (endPoseQuery(k, v, x1, reach, cp) && cp.distance < reach && cp.distance < nearest) {
+                nearest = cp.distance;
+                normal = cp.normal;
+            }
+        }
+        return normal;
+    };
+    const VecX dvBefore = mDv;
+    const RotationProjectionStats ps =
+        projectRotationLength(mEdges, mEdgeRest, mMass, mConstraints, x0, v0, mYPos, h, mDv,
+                              mOptions.rotationTolerance, hold);
+    // Every vertex it moved that a collider's surface came closer to (a curved one under a
+    // contact sliding in its plane, or under a vertex moving in the tangent plane of its
+    // nearest point): back out along the normal to the distance it had, or to the thickness.
+    for (size_t v = 0; v < vertexCount() && !mKin.colliders.empty(); ++v) {
+        if (vec3At(mDv.data(), v) == vec3At(dvBefore.data(), v)) continue;
+        const Vec3 x1 = vec3At(x0.data(), v) +
+                        h * (vec3At(v0.data(), v) + vec3At(dvBefore.data(), v)) +
+                        vec3At(mYPos.data(), v);
+        for (size_t k = 0; k < mKin.colliders.size(); ++k) {
+            const double thick = mKin.colliders[k].thickness;
+            const double reach = thick + kHoldMargin;
+            ContactPoint before, after;
+            const Vec3 x = endOf(v);
+            if (!endPoseQuery(k, v, x, reach, after) || !(after.distance < thick)) continue;
+            const double was = endPoseQuery(k, v, x1, reach, before) ? before.distance : reach;
+            const double floor = std::min(was, thick);
+            if (after.distance < floor)
+                vec3At(mDv.data(), v) += ((floor - after.distance) / h) * after.normal;
+        }
+    }
+    st.rotationEdges = ps.activeEdges;
+    st.rotationExcess = ps.excessBefore;
 }
 
 } // namespace gale::solver

@@ -91,6 +91,13 @@ struct StepOptions {
     // Symplectic (semi-implicit) Euler, v += h M⁻¹ f, x += h v: the explicit baseline the
     // benchmarks compare against (no linear solve; unstable when h·k > 2, see aero.md).
     bool explicitEuler = false;
+    // After the linearised step (when no Newton ran on it), the length its rotations added is
+    // projected out of every edge longer than both its rest length and the length the step saw
+    // by more than rotationTolerance × rest (rotation_projection.h, docs/solver.md; the scene's
+    // [solver] rotation_projection). Off by default: on a cloth flapping at one substep a frame
+    // most edges turn and it costs 1.7–2.6× the step (bench/README.md).
+    bool rotationProjection = false;
+    double rotationTolerance = 1e-3;
 };
 
 // What a substep sees of the world.
@@ -159,6 +166,10 @@ struct SubstepStatus {
     int contactConstraints = 0, contactAdded = 0, contactReleases = 0, contactSolves = 0;
     int clothConstraints = 0; // of contactConstraints: cloth held against cloth (setClothPlanes)
     int contactSlides = 0; // sticking contacts that turned to slide (friction at μ λ_n)
+    // The rotation projection (StepOptions::rotationProjection): edges beyond their target by
+    // more than the tolerance before it, and the largest excess over the target (× rest).
+    int rotationEdges = 0;
+    double rotationExcess = 0.0;
     int projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
 };
@@ -347,6 +358,8 @@ private:
     void landed();
     void rememberSliding(const VecX& v0, double h);
     void slide(size_t i, double c);
+    // The rotation-length projection of the linearised step (rotation_projection.h).
+    void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st);
     double slipOf(size_t i, const VecX& v0) const;
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);

@@ -428,6 +428,8 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         stats.contacts = st.contacts;
         stats.contactConstraints += st.contactConstraints;
         stats.clothConstraints += st.clothConstraints;
+        stats.rotationEdges += st.rotationEdges;
+        stats.rotationExcess = std::max(stats.rotationExcess, st.rotationExcess);
         stats.contactAdded += st.contactAdded;
         stats.contactReleases += st.contactReleases;
         stats.contactSlides += st.contactSlides;

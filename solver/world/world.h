@@ -87,6 +87,10 @@ struct BodyFrameStats {
     // largest approach speed it removed (m/s).
     long contactConstraints = 0;
     long clothConstraints = 0; // of contactConstraints: cloth held against cloth in the solve
+    // The rotation projection ([solver] rotation_projection): edges it found beyond their target,
+    // summed over the substeps, and the largest excess over the target (× rest).
+    long rotationEdges = 0;
+    double rotationExcess = 0.0;
     int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
         projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;

@@ -1,0 +1,208 @@
+// The rotation-length projection (rotation_projection.h): Gauss–Newton on
+//   min ½ (x − x₁)ᵀ M (x − x₁)  subject to  C_e(x) = |x_b − x_a| − T_e ≤ 0,
+// T_e = max(L_e, d̂₀·d₁) (the rest length, or the length the linearised step saw). Each
+// iteration solves (J W Jᵀ + α I) λ = C on the active edges (C_e > tolerance · L_e) by
+// Jacobi-preconditioned CG and moves x ← x − s W Jᵀ λ, W_i = P_i S_i P_i / m_i (S the constraint
+// filter: pins fixed, contacts in their plane; P a collider's plane near the vertex), the step s
+// halved until the merit Σ max(C, 0)² falls. The work is on the active edges and their vertices
+// only (a few hundred edges of a sheet where it turns about a contact ring or a whip's front).
+#include "solver/bodies/rotation_projection.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gale::solver {
+
+namespace {
+constexpr int kMaxIterations = 6;        // Gauss–Newton iterations
+constexpr int kMaxCg = 60;               // CG iterations per Gauss–Newton iteration
+constexpr double kCgTolerance = 1e-3;    // relative residual of each linear solve
+constexpr double kRegularisation = 1e-2; // α relative to the mean diagonal of J W Jᵀ
+constexpr int kMaxCuts = 10;             // step halvings of the merit's line search
+} // namespace
+
+RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 2>>& edges,
+                                              const std::vector<double>& rest, const VecX& mass,
+                                              const Constraints& constraints, const VecX& x0,
+                                              const VecX& v0, const VecX& y, double h, VecX& dv,
+                                              double tolerance,
+                                              const std::function<Vec3(int)>& hold) {
+    RotationProjectionStats stats;
+    const size_t n = static_cast<size_t>(mass.size());
+    VecX x = x0 + h * (v0 + dv) + y;
+    const auto at = [](const VecX& v, int i) { return Vec3(v.segment<3>(3 * i)); };
+    // Targets from the linearised end state, and the edges beyond them.
+    std::vector<double> target(edges.size());
+    std::vector<int> candidates; // edges beyond their target at x₁
+    double worst = 0.0;
+    for (size_t e = 0; e < edges.size(); ++e) {
+        const auto [a, b] = edges[e];
+        const Vec3 d0 = at(x0, b) - at(x0, a), d1 = at(x, b) - at(x, a);
+        const double l0 = d0.norm();
+        target[e] = l0 > 0.0 ? std::max(rest[e], d0.dot(d1) / l0) : rest[e];
+        const double excess = (d1.norm() - target[e]) / rest[e];
+        worst = std::max(worst, excess);
+        if (excess > tolerance) candidates.push_back(static_cast<int>(e));
+    }
+    stats.excessBefore = stats.excessAfter = worst;
+    stats.activeEdges = static_cast<int>(candidates.size());
+    if (candidates.empty()) return stats;
+    // W per vertex (3×3), computed when an edge of it first becomes active.
+    std::vector<Mat3> wOf(n);
+    std::vector<uint8_t> known(n, 0);
+    const auto weight = [&](int v) -> const Mat3& {
+        const size_t i = static_cast<size_t>(v);
+        if (!known[i]) {
+            known[i] = 1;
+            const double m = mass[static_cast<long>(i)];
+            wOf[i] = m > 0.0 ? Mat3(constraints.filter(i) / m) : Mat3(Mat3::Zero());
+            const Vec3 nn = constraints.kind[i] == 0 && hold ? hold(v) : Vec3(Vec3::Zero());
+            if (nn.squaredNorm() > 0.0) {
+                const Mat3 plane = Mat3::Identity() - nn * nn.transpose();
+                wOf[i] = plane * wOf[i] * plane;
+            }
+        }
+        return wOf[i];
+    };
+    // The merit over every edge (a move may lengthen an edge that was not active).
+    const auto merit = [&](const VecX& p) {
+        double f = 0.0;
+        for (size_t e = 0; e < edges.size(); ++e) {
+            const auto [a, b] = edges[e];
+            const double ex = (at(p, b) - at(p, a)).norm() - target[e];
+            if (ex > 0.0) f += ex * ex;
+        }
+        return f;
+    };
+    std::vector<int> slot(n, -1), verts;
+    std::vector<Mat3> w;
+
+    std::vector<int> active;
+    std::vector<Vec3> dir, u;
+    std::vector<double> c, lambda, r, z, p, q, diag;
+    VecX trial;
+    for (int it = 0; it < kMaxIterations; ++it) {
+        active.clear();
+        dir.clear();
+        c.clear();
+        for (int v : verts) slot[static_cast<size_t>(v)] = -1;
+        verts.clear();
+        w.clear();
+        for (size_t e = 0; e < edges.size(); ++e) {
+            const auto [a, b] = edges[e];
+            const Vec3 d = at(x, b) - at(x, a);
+            const double len = d.norm();
+            const double excess = len - target[e];
+            if (!(excess > tolerance * rest[e]) || !(len > 0.0)) continue;
+            active.push_back(static_cast<int>(e));
+            dir.push_back(d / len);
+            c.push_back(excess);
+            for (int v : edges[e])
+                if (slot[static_cast<size_t>(v)] < 0) {
+                    slot[static_cast<size_t>(v)] = static_cast<int>(verts.size());
+                    verts.push_back(v);
+                    w.push_back(weight(v));
+                }
+        }
+        if (active.empty()) break;
+        u.resize(verts.size());
+        ++stats.iterations;
+        const size_t m = active.size();
+        const auto ends = [&](size_t k) {
+            const auto [a, b] = edges[static_cast<size_t>(active[k])];
+            return std::array<int, 2>{slot[static_cast<size_t>(a)], slot[static_cast<size_t>(b)]};
+        };
+        diag.assign(m, 0.0);
+        double mean = 0.0;
+        for (size_t k = 0; k < m; ++k) {
+            const auto [sa, sb] = ends(k);
+            diag[k] = dir[k].dot((w[sa] + w[sb]) * dir[k]);
+            mean += diag[k];
+        }
+        const double alpha = kRegularisation * mean / static_cast<double>(m);
+        for (double& d : diag) d += alpha;
+        // out = (J W Jᵀ + α I) v.
+        const auto apply = [&](const std::vector<double>& v, std::vector<double>& out) {
+            std::fill(u.begin(), u.end(), Vec3::Zero());
+            for (size_t k = 0; k < m; ++k) {
+                const auto [sa, sb] = ends(k);
+                u[sa] -= v[k] * dir[k];
+                u[sb] += v[k] * dir[k];
+            }
+            for (size_t k = 0; k < verts.size(); ++k) u[k] = w[k] * u[k];
+            out.resize(m);
+            for (size_t k = 0; k < m; ++k) {
+                const auto [sa, sb] = ends(k);
+                out[k] = dir[k].dot(u[sb] - u[sa]) + alpha * v[k];
+            }
+        };
+        lambda.assign(m, 0.0);
+        r = c;
+        z.resize(m);
+        double rz = 0.0, r0 = 0.0;
+        for (size_t k = 0; k < m; ++k) {
+            z[k] = diag[k] > 0.0 ? r[k] / diag[k] : 0.0;
+            rz += r[k] * z[k];
+            r0 += r[k] * r[k];
+        }
+        p = z;
+        r0 = std::sqrt(r0);
+        for (int cg = 0; cg < kMaxCg && r0 > 0.0; ++cg) {
+            apply(p, q);
+            double pq = 0.0;
+            for (size_t k = 0; k < m; ++k) pq += p[k] * q[k];
+            if (!(pq > 0.0)) break;
+            const double step = rz / pq;
+            double rr = 0.0;
+            for (size_t k = 0; k < m; ++k) {
+                lambda[k] += step * p[k];
+                r[k] -= step * q[k];
+                rr += r[k] * r[k];
+            }
+            ++stats.cgIterations;
+            if (std::sqrt(rr) <= kCgTolerance * r0) break;
+            double rzNew = 0.0;
+            for (size_t k = 0; k < m; ++k) {
+                z[k] = diag[k] > 0.0 ? r[k] / diag[k] : 0.0;
+                rzNew += r[k] * z[k];
+            }
+            const double beta = rzNew / rz;
+            rz = rzNew;
+            for (size_t k = 0; k < m; ++k) p[k] = z[k] + beta * p[k];
+        }
+        // The step −W Jᵀ λ on the vertices of the active edges, halved until the merit falls.
+        std::fill(u.begin(), u.end(), Vec3::Zero());
+        for (size_t k = 0; k < m; ++k) {
+            const auto [sa, sb] = ends(k);
+            u[sa] -= lambda[k] * dir[k];
+            u[sb] += lambda[k] * dir[k];
+        }
+        for (size_t k = 0; k < verts.size(); ++k) u[k] = w[k] * u[k];
+        const double f0 = merit(x);
+        double s = 1.0;
+        bool lowered = false;
+        trial = x;
+        for (int cut = 0; cut <= kMaxCuts; ++cut, s *= 0.5) {
+            for (size_t k = 0; k < verts.size(); ++k)
+                trial.segment<3>(3 * verts[k]) = at(x, verts[k]) - s * u[k];
+            if (merit(trial) < f0) {
+                lowered = true;
+                break;
+            }
+        }
+        if (!lowered) break;
+        for (int v : verts) x.segment<3>(3 * v) = trial.segment<3>(3 * v);
+    }
+    worst = 0.0;
+    for (size_t e = 0; e < edges.size(); ++e) {
+        const auto [a, b] = edges[e];
+        worst = std::max(worst, ((at(x, b) - at(x, a)).norm() - target[e]) / rest[e]);
+    }
+    stats.excessAfter = worst;
+    if (!x.allFinite()) return stats; // Δv left as the linearised step's
+    for (size_t v = 0; v < n; ++v)
+        if (known[v]) dv.segment<3>(3 * v) = (at(x, v) - at(x0, v) - at(y, v)) / h - at(v0, v);
+    return stats;
+}
+
+} // namespace gale::solver

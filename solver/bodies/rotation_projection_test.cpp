@@ -1,0 +1,67 @@
+// The rotation-length projection on single edges with closed-form answers: an edge turned within
+// the step ends at its rest length, its centre of mass where the linearised step put it (free
+// ends) or its pinned end where it was; a stretch the step saw along the edge is kept.
+#include "solver/bodies/rotation_projection.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace gale::solver;
+
+namespace {
+struct OneEdge {
+    std::vector<std::array<int, 2>> edges{{0, 1}};
+    std::vector<double> rest{0.1};
+    VecX mass = VecX::Constant(2, 0.01);
+    Constraints c;
+    VecX x0 = VecX::Zero(6), v0 = VecX::Zero(6), y = VecX::Zero(6), dv = VecX::Zero(6);
+    double h = 1.0 / 24.0;
+    OneEdge() {
+        c.reset(2);
+        x0[3] = 0.1; // along x, at rest
+    }
+    Vec3 end(int i) const { return x0.segment<3>(3 * i) + h * (v0 + dv).segment<3>(3 * i); }
+};
+} // namespace
+
+TEST_CASE("rotation projection: a turned edge ends at its rest length", "[rotation]") {
+    OneEdge e;
+    // The far end moves 3 cm across the edge within the step: the linearised length along the
+    // start direction is the rest length, the end's 0.1 √(1 + 0.09) (4.4 % longer).
+    e.dv.segment<3>(3) = Vec3(0.0, 0.03, 0.0) / e.h;
+    const Vec3 centre = 0.5 * (e.end(0) + e.end(1));
+    const RotationProjectionStats s =
+        projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6);
+    CHECK(s.activeEdges == 1);
+    CHECK(s.excessBefore == Approx(std::sqrt(1.09) - 1.0).epsilon(1e-9));
+    CHECK((e.end(1) - e.end(0)).norm() == Approx(0.1).epsilon(1e-5));
+    // Equal masses, momentum kept: the centre stays; the edge keeps its end direction.
+    CHECK((0.5 * (e.end(0) + e.end(1)) - centre).norm() < 1e-12);
+    const Vec3 d = (e.end(1) - e.end(0)).normalized();
+    CHECK(std::abs(d.y() / d.x() - 0.3) < 1e-9);
+}
+
+TEST_CASE("rotation projection: a pinned end stays, the free end comes in", "[rotation]") {
+    OneEdge e;
+    e.c.kind[0] = 1; // pinned
+    e.dv.segment<3>(3) = Vec3(0.0, 0.03, 0.0) / e.h;
+    projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6);
+    CHECK(e.end(0).norm() == 0.0);
+    CHECK(e.end(1).norm() == Approx(0.1).epsilon(1e-5)); // on the circle about the pin
+}
+
+TEST_CASE("rotation projection: a stretch the step saw is not undone", "[rotation]") {
+    OneEdge e;
+    // 5 % along the edge (the linearised step saw it: its force balanced it), no turn.
+    e.dv.segment<3>(3) = Vec3(0.005, 0.0, 0.0) / e.h;
+    const VecX before = e.dv;
+    const RotationProjectionStats s =
+        projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6);
+    CHECK(s.activeEdges == 0);
+    CHECK(e.dv == before);
+    // The same stretch plus a turn: back to 5 % over rest, not to rest.
+    e.dv.segment<3>(3) = Vec3(0.005, 0.03, 0.0) / e.h;
+    projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6);
+    CHECK((e.end(1) - e.end(0)).norm() == Approx(0.105).epsilon(1e-5));
+}
