@@ -121,8 +121,8 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
         }
         const double alpha = kRegularisation * mean / static_cast<double>(m);
         for (double& d : diag) d += alpha;
-        // out = (J W Jᵀ + α I) v.
-        const auto apply = [&](const std::vector<double>& v, std::vector<double>& out) {
+        // u = W Jᵀ v (per vertex of the active edges).
+        const auto spread = [&](const std::vector<double>& v) {
             std::fill(u.begin(), u.end(), Vec3::Zero());
             for (size_t k = 0; k < m; ++k) {
                 const auto [sa, sb] = ends(k);
@@ -130,6 +130,10 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
                 u[sb] += v[k] * dir[k];
             }
             for (size_t k = 0; k < verts.size(); ++k) u[k] = w[k] * u[k];
+        };
+        // out = (J W Jᵀ + α I) v.
+        const auto apply = [&](const std::vector<double>& v, std::vector<double>& out) {
+            spread(v);
             out.resize(m);
             for (size_t k = 0; k < m; ++k) {
                 const auto [sa, sb] = ends(k);
@@ -171,13 +175,7 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
             for (size_t k = 0; k < m; ++k) p[k] = z[k] + beta * p[k];
         }
         // The step −W Jᵀ λ on the vertices of the active edges, halved until the merit falls.
-        std::fill(u.begin(), u.end(), Vec3::Zero());
-        for (size_t k = 0; k < m; ++k) {
-            const auto [sa, sb] = ends(k);
-            u[sa] -= lambda[k] * dir[k];
-            u[sb] += lambda[k] * dir[k];
-        }
-        for (size_t k = 0; k < verts.size(); ++k) u[k] = w[k] * u[k];
+        spread(lambda);
         const double f0 = merit(x);
         double s = 1.0;
         bool lowered = false;
