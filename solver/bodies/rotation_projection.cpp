@@ -40,6 +40,7 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
         const Vec3 d0 = at(x0, b) - at(x0, a), d1 = at(x, b) - at(x, a);
         const double l0 = d0.norm();
         target[e] = l0 > 0.0 ? std::max(rest[e], d0.dot(d1) / l0) : rest[e];
+        if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
         const double excess = (d1.norm() - target[e]) / rest[e];
         worst = std::max(worst, excess);
         if (excess > tolerance) candidates.push_back(static_cast<int>(e));
@@ -68,6 +69,7 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
     const auto merit = [&](const VecX& p) {
         double f = 0.0;
         for (size_t e = 0; e < edges.size(); ++e) {
+            if (!(rest[e] > 0.0)) continue;
             const auto [a, b] = edges[e];
             const double ex = (at(p, b) - at(p, a)).norm() - target[e];
             if (ex > 0.0) f += ex * ex;
@@ -93,7 +95,7 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
             const Vec3 d = at(x, b) - at(x, a);
             const double len = d.norm();
             const double excess = len - target[e];
-            if (!(excess > tolerance * rest[e]) || !(len > 0.0)) continue;
+            if (!(excess > tolerance * rest[e]) || !(len > 0.0) || !(rest[e] > 0.0)) continue;
             active.push_back(static_cast<int>(e));
             dir.push_back(d / len);
             c.push_back(excess);
@@ -194,7 +196,8 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
     worst = 0.0;
     for (size_t e = 0; e < edges.size(); ++e) {
         const auto [a, b] = edges[e];
-        worst = std::max(worst, ((at(x, b) - at(x, a)).norm() - target[e]) / rest[e]);
+        if (rest[e] > 0.0)
+            worst = std::max(worst, ((at(x, b) - at(x, a)).norm() - target[e]) / rest[e]);
     }
     stats.excessAfter = worst;
     if (!x.allFinite()) return stats; // Δv left as the linearised step's
