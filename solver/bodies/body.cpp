@@ -167,16 +167,9 @@ double Body::potentialEnergy(const Vec3& gravity) const {
 }
 
 double Body::elasticEnergy(double t) {
-    VecX f = VecX::Zero(mX.size());
-    ForceInput in;
-    in.x = mX.data();
-    in.v = mV.data();
-    in.t = t;
-    ForceOutput out;
-    out.f = &f;
-    addForces(in, out);
-    addSoftAttachments(in, out, false);
-    return out.elasticEnergy;
+    // The energy does not depend on the velocities (elasticAt evaluates the forces at rest).
+    VecX f;
+    return elasticAt(mX, t, f);
 }
 
 void Body::attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const {
