@@ -676,13 +676,14 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
 // nothing to do.
 void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st) {
     constexpr double kHoldMargin = 0.01; // m
-    const auto endOf = [&](size_t v) {
-        return Vec3(vec3At(x0.data(), v) + h * (vec3At(v0.data(), v) + vec3At(mDv.data(), v)) +
+    // Vertex v's end position with velocity change dv.
+    const auto endOf = [&](const VecX& dv, size_t v) {
+        return Vec3(vec3At(x0.data(), v) + h * (vec3At(v0.data(), v) + vec3At(dv.data(), v)) +
                     vec3At(mYPos.data(), v));
     };
     const auto hold = [&](int i) {
         const size_t v = static_cast<size_t>(i);
-        const Vec3 x1 = endOf(v);
+        const Vec3 x1 = endOf(mDv, v);
         Vec3 normal = Vec3::Zero();
         double nearest = INFINITY;
         for (size_t k = 0; k < mKin.colliders.size(); ++k) {
@@ -704,14 +705,12 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
     // nearest point): back out along the normal to the distance it had, or to the thickness.
     for (size_t v = 0; v < vertexCount() && !mKin.colliders.empty(); ++v) {
         if (vec3At(mDv.data(), v) == vec3At(dvBefore.data(), v)) continue;
-        const Vec3 x1 = vec3At(x0.data(), v) +
-                        h * (vec3At(v0.data(), v) + vec3At(dvBefore.data(), v)) +
-                        vec3At(mYPos.data(), v);
+        const Vec3 x1 = endOf(dvBefore, v);
         for (size_t k = 0; k < mKin.colliders.size(); ++k) {
             const double thick = mKin.colliders[k].thickness;
             const double reach = thick + kHoldMargin;
             ContactPoint before, after;
-            const Vec3 x = endOf(v);
+            const Vec3 x = endOf(mDv, v);
             if (!endPoseQuery(k, v, x, reach, after) || !(after.distance < thick)) continue;
             const double was = endPoseQuery(k, v, x1, reach, before) ? before.distance : reach;
             const double floor = std::min(was, thick);

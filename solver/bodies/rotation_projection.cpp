@@ -31,9 +31,9 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
     const size_t n = static_cast<size_t>(mass.size());
     VecX x = x0 + h * (v0 + dv) + y;
     const auto at = [](const VecX& v, int i) { return Vec3(v.segment<3>(3 * i)); };
-    // Targets from the linearised end state, and the edges beyond them.
+    // Targets from the linearised end state, and how many edges are beyond them.
     std::vector<double> target(edges.size());
-    std::vector<int> candidates; // edges beyond their target at x₁
+    int beyond = 0;
     double worst = 0.0;
     for (size_t e = 0; e < edges.size(); ++e) {
         const auto [a, b] = edges[e];
@@ -43,11 +43,11 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
         if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
         const double excess = (d1.norm() - target[e]) / rest[e];
         worst = std::max(worst, excess);
-        if (excess > tolerance) candidates.push_back(static_cast<int>(e));
+        if (excess > tolerance) ++beyond;
     }
     stats.excessBefore = stats.excessAfter = worst;
-    stats.activeEdges = static_cast<int>(candidates.size());
-    if (candidates.empty()) return stats;
+    stats.activeEdges = beyond;
+    if (beyond == 0) return stats;
     // W per vertex (3×3), computed when an edge of it first becomes active.
     std::vector<Mat3> wOf(n);
     std::vector<uint8_t> known(n, 0);
