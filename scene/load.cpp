@@ -33,7 +33,6 @@ bool loadSimScene(const std::string& path, SimScene& out,
     startScene(path, out.wind);
     SceneLoadOptions options;
     options.sets = sets;
-    options.foreignSections = {"cloth", "hair", "collider", "solver"};
     std::string text;
     toml::table root;
     if (!readSceneFile(path, text, root, errors)) return false;

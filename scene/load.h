@@ -16,9 +16,9 @@ struct SceneLoadOptions {
     // `--set KEY=VALUE` overrides by dotted path (`windicator.speed=12`, `field.main.params.swirl=0.3`,
     // `scene.fps=30`); an unknown path is an error.
     std::vector<std::string> sets;
-    // Top-level sections left to the bodies' half of the loader (loadSimScene adds "solver");
-    // any other unknown key is an error.
-    std::vector<std::string> foreignSections{"cloth", "hair", "collider"};
+    // Top-level sections left to the bodies' half of the loader; any other unknown key is an
+    // error.
+    std::vector<std::string> foreignSections{"cloth", "hair", "collider", "solver"};
 };
 
 // Reads and validates the wind part of a scene file. Errors carry file:line:col (toml++

@@ -108,6 +108,9 @@ source = '''
 
 [[cloth]]
 name = "cape"
+
+[solver]
+max_halvings = 4
 )TOML");
     INFO(l.rendered());
     REQUIRE(l.ok);
@@ -275,7 +278,8 @@ params = { spread = 3 }
                     {"scene.fps=30", "windicator.direction=0,0,1", "windicator.speed=12",
                      "gust.big.start=1.5", "gust.0.travel_speed=2",
                      "field.main.params.spread={ keys = [[0, 1], [2, 5]] }",
-                     "field.0.params.turbulence=0.1", "field.main.scale=0.5", "cloth.cape.drag=0.8"});
+                     "field.0.params.turbulence=0.1", "field.main.scale=0.5", "cloth.cape.drag=0.8",
+                     "solver.max_halvings=4"});
     INFO(l.rendered());
     REQUIRE(l.ok);
     CHECK(l.scene.settings.fps == 30);
