@@ -6,6 +6,10 @@ Reports the wall seconds summed from run.json (the frames' wall_seconds), the CG
 summed over the frames and objects (a count, independent of the machine's load), and the ratios.
 
     bench/example_contact_cost.py [--gale build/cli/gale] [--repeats 1] [--only 10_hair_turn,...]
+    bench/example_contact_cost.py --rotation [--repeats 1] [--only ...]
+
+With --rotation, each example as shipped instead with [solver] rotation_projection "off", "contact"
+(the default) and "always", alternating: the seconds against "off" and the largest stretch.
 
 Each example's assets are made first with its README's generator (make_head.py, make_body.py,
 make_character.py) in a scratch folder; nothing is written inside examples/."""
@@ -58,9 +62,24 @@ def run(gale, folder, scene, out, extra):
     return {"wall": wall, "sim": sim, "its": its, "solves": solves, "stretch": stretch}
 
 
+def rotation_modes(gale, folder, name, repeats):
+    """One row: the example as shipped with each rotation_projection mode, "off" the baseline."""
+    modes = ("off", "contact", "always")
+    best = {}
+    for rep in range(repeats):
+        for m in modes:
+            r = run(gale, folder, "scene.toml", "out_" + m, ["--set", "solver.rotation_projection=" + m])
+            if m not in best or r["sim"] < best[m]["sim"]:
+                best[m] = r
+    off = best["off"]
+    print("| %s | %s | %s |" % (name, " | ".join(
+        "%.2f (%.2f×)" % (best[m]["sim"], best[m]["sim"] / max(off["sim"], 1e-9)) for m in modes),
+        " / ".join("%.3f" % best[m]["stretch"] for m in modes)), flush=True)
+
+
 def main(argv):
     gale = os.path.join(ROOT, "build", "cli", "gale")
-    repeats, only = 1, None
+    repeats, only, rotation = 1, None, False
     i = 0
     while i < len(argv):
         if argv[i] == "--gale":
@@ -69,12 +88,20 @@ def main(argv):
             repeats = int(argv[i + 1]); i += 2
         elif argv[i] == "--only":
             only = argv[i + 1].split(","); i += 2
+        elif argv[i] == "--rotation":
+            rotation = True; i += 1
         else:
-            sys.exit("usage: example_contact_cost.py [--gale PATH] [--repeats N] [--only A,B]")
+            sys.exit("usage: example_contact_cost.py [--gale PATH] [--repeats N] [--only A,B] "
+                     "[--rotation]")
     py = "/usr/bin/python3" if os.access("/usr/bin/python3", os.X_OK) else sys.executable
-    print("| example | sim s with colliders | without | time ratio | CG iterations with / "
-          "without | ratio | linear solves with / without | max stretch with / without |")
-    print("|---|---|---|---|---|---|---|---|")
+    if rotation:
+        print("| example | sim s, rotation_projection off | contact (default) | always | "
+              "max stretch off / contact / always |")
+        print("|---|---|---|---|---|")
+    else:
+        print("| example | sim s with colliders | without | time ratio | CG iterations with / "
+              "without | ratio | linear solves with / without | max stretch with / without |")
+        print("|---|---|---|---|---|---|---|---|")
     for name, (gen, extra) in EXAMPLES.items():
         if only and name not in only:
             continue
@@ -84,6 +111,9 @@ def main(argv):
             shutil.copytree(os.path.join(ROOT, "examples", name), folder)
             if gen:
                 subprocess.run([py] + gen, cwd=folder, check=True, stdout=subprocess.DEVNULL)
+            if rotation:
+                rotation_modes(gale, folder, name, repeats)
+                continue
             text = open(os.path.join(folder, "scene.toml")).read()
             with open(os.path.join(folder, "no_colliders.toml"), "w") as f:
                 f.write(without_colliders(text))

@@ -68,7 +68,8 @@ std::string settingsJson(const scene::SimScene& sc,
       << ", \"retry_repeat\": " << (sc.solver.retryRepeat ? "true" : "false")
       << ", \"grow_back\": " << (sc.solver.growBack ? "true" : "false")
       << ", \"retry_strain_limit\": " << (sc.solver.strainLimit ? "true" : "false")
-      << ", \"rotation_projection\": " << (sc.solver.rotationProjection ? "true" : "false") << "}";
+      << ", \"rotation_projection\": "
+      << jsonString(rotationProjectionName(sc.solver.rotationProjection)) << "}";
     o << ", \"fields\": [";
     for (size_t i = 0; i < sc.wind.fields.size(); ++i)
         o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
@@ -159,8 +160,8 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"contact_solve\": {\"constraints\": " << b.contactConstraints
           << ", \"added\": " << b.contactAdded << ", \"released\": " << b.contactReleases
           << ", \"slid\": " << b.contactSlides << ", \"extra_solves\": " << b.contactSolves
-          << "}, \"rotation_projection\": {\"edges\": " << b.rotationEdges
-          << ", \"max_excess\": " << num(b.rotationExcess)
+          << "}, \"rotation_projection\": {\"substeps\": " << b.rotationSubsteps
+          << ", \"edges\": " << b.rotationEdges << ", \"max_excess\": " << num(b.rotationExcess)
           << "}, \"contact_projection\": {\"vertices\": " << b.projected
           << ", \"max_distance\": " << num(b.projectedDistance)
           << ", \"max_speed\": " << num(b.projectedSpeed) << "}";

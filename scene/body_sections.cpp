@@ -698,8 +698,22 @@ void Loader::loadSolver(const toml::table& t, SolverSection& s) {
     if (const toml::node* n = t.get("grow_back")) boolean(*n, "[solver] grow_back", s.growBack);
     if (const toml::node* n = t.get("retry_strain_limit"))
         boolean(*n, "[solver] retry_strain_limit", s.strainLimit);
-    if (const toml::node* n = t.get("rotation_projection"))
-        boolean(*n, "[solver] rotation_projection", s.rotationProjection);
+    if (const toml::node* n = t.get("rotation_projection")) {
+        // "off", "contact" (the default) or "always"; false and true stand for off and always.
+        std::string v;
+        if (n->is_boolean())
+            v = n->value<bool>().value_or(false) ? "always" : "off";
+        else if (!n->is_string()) {
+            error(*n, std::string("[solver] rotation_projection must be \"off\", \"contact\" or "
+                                  "\"always\" (or false, true), not ") +
+                          tomlTypeName(*n));
+            return;
+        } else if (!choice(*n, "[solver] rotation_projection", {"off", "contact", "always"}, v))
+            return;
+        s.rotationProjection = v == "off"       ? solver::RotationProjection::Off
+                               : v == "contact" ? solver::RotationProjection::Contact
+                                                : solver::RotationProjection::Always;
+    }
 }
 
 void Loader::load(const toml::table& root, const std::string& baseDir, SimScene& out) {

@@ -243,7 +243,7 @@ rotation_projection = true
 )");
     INFO(ok.all());
     REQUIRE(ok.ok);
-    CHECK(ok.scene.solver.rotationProjection);
+    CHECK(ok.scene.solver.rotationProjection == RotationProjection::Always);
     CHECK(ok.scene.solver.retryNewton == 2);
     CHECK(ok.scene.solver.retryCgTolerance == 0.05);
     CHECK(ok.scene.solver.retryKeepCoarse);
@@ -275,6 +275,39 @@ grow_back = "yes"
     CHECK(all.find(path + ":7:22: error: [solver] retry_cg_tolerance must be below 1") !=
           std::string::npos);
     CHECK(all.find(path + ":8:13: error: [solver] grow_back must be true or false") !=
+          std::string::npos);
+}
+
+TEST_CASE("scene: [solver] rotation_projection is off, contact (the default) or always",
+          "[scene]") {
+    TempDir dir;
+    const auto with = [&](const std::string& value) {
+        return load(dir,
+                    "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n" +
+                        (value.empty() ? "" : "[solver]\nrotation_projection = " + value + "\n"));
+    };
+    const auto mode = [&](const std::string& value) {
+        const Loaded l = with(value);
+        INFO(value << ": " << l.all());
+        REQUIRE(l.ok);
+        return l.scene.solver.rotationProjection;
+    };
+    CHECK(mode("") == RotationProjection::Contact);
+    CHECK(mode("\"contact\"") == RotationProjection::Contact);
+    CHECK(mode("\"off\"") == RotationProjection::Off);
+    CHECK(mode("false") == RotationProjection::Off);
+    CHECK(mode("\"always\"") == RotationProjection::Always);
+    CHECK(mode("true") == RotationProjection::Always);
+    const std::string path = (dir.path / "scene.toml").string();
+    const Loaded typo = with("\"contacts\"");
+    CHECK_FALSE(typo.ok);
+    CHECK(typo.all().find(path + ":5:23: error: unknown [solver] rotation_projection 'contacts' "
+                                 "(use \"off\", \"contact\", \"always\")") != std::string::npos);
+    CHECK(typo.all().find("did you mean 'contact'") != std::string::npos);
+    const Loaded number = with("1");
+    CHECK_FALSE(number.ok);
+    CHECK(number.all().find(path + ":5:23: error: [solver] rotation_projection must be \"off\", "
+                                   "\"contact\" or \"always\" (or false, true), not ") !=
           std::string::npos);
 }
 

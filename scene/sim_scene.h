@@ -108,9 +108,9 @@ struct SolverSection {
     bool retryRepeat = solver::WorldSettings{}.retryRepeat;
     bool growBack = solver::WorldSettings{}.growBack;
     bool strainLimit = false;
-    // Every body's linearised step has the length its rotations add projected out
-    // (solver::StepOptions::rotationProjection).
-    bool rotationProjection = false;
+    // When the length a linearised step's rotations add is projected out of every body's edges
+    // (solver::StepOptions::rotationProjection): "off", "contact" (default) or "always".
+    solver::RotationProjection rotationProjection = solver::StepOptions{}.rotationProjection;
 };
 
 struct SimScene {

@@ -37,6 +37,12 @@ bool PaintedParam::alwaysZero() const {
     return true;
 }
 
+const char* rotationProjectionName(RotationProjection r) {
+    return r == RotationProjection::Off       ? "off"
+           : r == RotationProjection::Contact ? "contact"
+                                              : "always";
+}
+
 const char* troubleName(Trouble t) {
     switch (t) {
     case Trouble::None:
@@ -597,8 +603,9 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     }
     // 5b. ... else the length the linearised step's rotations added, projected out
     // (rotation_projection.h).
-    if (st.converged && !mOptions.explicitEuler && mOptions.rotationProjection &&
-        st.newtonIterations == 0)
+    if (st.converged && !mOptions.explicitEuler && st.newtonIterations == 0 &&
+        (mOptions.rotationProjection == RotationProjection::Always ||
+         (mOptions.rotationProjection == RotationProjection::Contact && colliderHolds())))
         projectRotations(x0, v0, h, st);
     mDvGuess = mDv;
     mHGuess = h;
@@ -669,6 +676,12 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     return st;
 }
 
+bool Body::colliderHolds() const {
+    const int colliders = static_cast<int>(mKin.colliders.size()); // beyond: cloth planes
+    return std::any_of(mContactCollider.begin(), mContactCollider.end(),
+                       [&](int c) { return c >= 0 && c < colliders; });
+}
+
 // The rotation-length projection of the linearised step (rotation_projection.h). A free vertex
 // that ends the step within a collider's thickness plus kHoldMargin of it moves only along that
 // collider's surface (its tangent plane there), and afterwards back out to the distance it had
@@ -718,6 +731,7 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
                 vec3At(mDv.data(), v) += ((floor - after.distance) / h) * after.normal;
         }
     }
+    st.rotationProjected = true;
     st.rotationEdges = ps.activeEdges;
     st.rotationExcess = ps.excessBefore;
 }

@@ -61,6 +61,13 @@ struct PinSet {
     double stiffness = 0.0;
 };
 
+// When the length a linearised step's rotations add is projected out (rotation_projection.h):
+// never, in the substeps where a collider holds one of the body's vertices in the solve (the
+// default: an impact turns the free cloth about the contact within one step), or in every
+// substep (a cloth flapping at one substep a frame too, at 1.7–2.6× the step's cost).
+enum class RotationProjection : uint8_t { Off, Contact, Always };
+const char* rotationProjectionName(RotationProjection r); // "off", "contact", "always"
+
 // Numerical settings of a body's substep.
 struct StepOptions {
     AeroJacobian aeroJacobian = AeroJacobian::Projected;
@@ -94,9 +101,10 @@ struct StepOptions {
     // After the linearised step (when no Newton ran on it), the length its rotations added is
     // projected out of every edge longer than both its rest length and the length the step saw
     // by more than rotationTolerance × rest (rotation_projection.h, docs/solver.md; the scene's
-    // [solver] rotation_projection). Off by default: on a cloth flapping at one substep a frame
-    // most edges turn and it costs 1.7–2.6× the step (bench/README.md).
-    bool rotationProjection = false;
+    // [solver] rotation_projection): by default only in substeps with a collider contact in the
+    // solve; a cloth flapping in free air at one substep a frame turns most of its edges and
+    // projecting there costs 1.7–2.6× the step (bench/README.md).
+    RotationProjection rotationProjection = RotationProjection::Contact;
     double rotationTolerance = 1e-3;
 };
 
@@ -170,6 +178,7 @@ struct SubstepStatus {
     // more than the tolerance before it, and the largest excess over the target (× rest).
     int rotationEdges = 0;
     double rotationExcess = 0.0;
+    bool rotationProjected = false; // the projection ran in this substep
     int projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
 };
@@ -358,7 +367,9 @@ private:
     void landed();
     void rememberSliding(const VecX& v0, double h);
     void slide(size_t i, double c);
-    // The rotation-length projection of the linearised step (rotation_projection.h).
+    // The rotation-length projection of the linearised step (rotation_projection.h), and whether
+    // a collider holds a vertex in the solve (RotationProjection::Contact runs it then).
+    bool colliderHolds() const;
     void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st);
     double slipOf(size_t i, const VecX& v0) const;
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
+#include <tuple>
 
 using namespace gale::solver;
 using namespace gale::solver::testing;
@@ -24,7 +26,9 @@ enum class Drop { FlatOnSphere, EdgeOnGround };
 // The issue's scenes: a 0.5 m sheet, 24 × 24 vertices, 0.1 kg/m², 2000 N/m, no wind, dropped
 // from 0.25 m (flat, over a sphere of radius 0.15 m at the origin; or hanging vertically, its
 // lower edge 0.25 m above the ground plane y = 0).
-std::unique_ptr<World> dropScene(Drop d, int substeps, bool rotations = false) {
+constexpr RotationProjection kDefault = StepOptions{}.rotationProjection;
+
+std::unique_ptr<World> dropScene(Drop d, int substeps, RotationProjection rotations = kDefault) {
     ClothMaterial m;
     m.density = 0.1;
     m.stretch = Param(2000.0);
@@ -63,9 +67,12 @@ struct DropRun {
     int rejected = 0, newtonRetries = 0, recovered = 0;
     int projected = 0; // vertices the projection after the solve still moved or stopped
     double projectedDistance = 0.0; // m: its largest push-out
+    std::vector<int> rotationSubsteps; // per frame: substeps the rotation projection ran in
+    std::vector<int> contacts;         // per frame: vertices in contact at its end
 };
 
-DropRun runDrop(Drop d, int substeps, int frames = 48, bool print = false, bool rotations = false) {
+DropRun runDrop(Drop d, int substeps, int frames = 48, bool print = false,
+                RotationProjection rotations = kDefault) {
     auto w = dropScene(d, substeps, rotations);
     DropRun r;
     for (int f = 1; f <= frames; ++f) {
@@ -79,6 +86,8 @@ DropRun runDrop(Drop d, int substeps, int frames = 48, bool print = false, bool 
         r.recovered += b.recovered;
         r.projected += b.projected;
         r.projectedDistance = std::max(r.projectedDistance, b.projectedDistance);
+        r.rotationSubsteps.push_back(b.rotationSubsteps);
+        r.contacts.push_back(b.contacts);
         if (print)
             std::printf("frame %2d substeps %3d rejected %d retries %d stretch %.4f ke %.3e "
                         "elastic %.3e contacts %d vmax %.4f | c %ld add %d rel %d slides %d "
@@ -94,7 +103,7 @@ DropRun runDrop(Drop d, int substeps, int frames = 48, bool print = false, bool 
 // The goals of issue 25 against the 16-substep run of the same scene, computed here: the strain
 // (stretch − 1) at most 1.5× the reference's plus 1 %, the kinetic energy after the impact at
 // most 1.2× plus 1 mJ, no halving, no Newton retry, and no push-out left for the projection.
-void checkAgainstReference(Drop d, bool goal, bool rotations = false) {
+void checkAgainstReference(Drop d, bool goal, RotationProjection rotations = kDefault) {
     const DropRun fine = runDrop(d, 16, 48, false, rotations);
     const DropRun coarse = runDrop(d, 1, 48, false, rotations);
     // After the impact: from the frame after both runs first end a frame in contact.
@@ -123,34 +132,89 @@ void checkAgainstReference(Drop d, bool goal, bool rotations = false) {
 
 } // namespace
 
-TEST_CASE("contact in the solve: a sheet dropped edge-first onto the ground at one substep "
-          "per frame",
-          "[contact]") {
-    checkAgainstReference(Drop::EdgeOnGround, false);
-}
-
-TEST_CASE("contact in the solve: the edge-first drop's goals", "[.goal][contact]") {
+// With the rotation projection as shipped (rotation_projection.h: in the substeps where a collider
+// holds a vertex in the solve) both drops meet every goal of the issue at one substep a frame,
+// the stretch one included.
+TEST_CASE("contact in the solve: the drops' goals at one substep per frame", "[contact]") {
+    checkAgainstReference(Drop::FlatOnSphere, true);
     checkAgainstReference(Drop::EdgeOnGround, true);
 }
 
-TEST_CASE("contact in the solve: a sheet dropped flat onto a sphere at one substep per frame",
+// Projecting in every substep (rotation_projection = "always") meets them as well.
+TEST_CASE("contact in the solve: the drops' goals with the projection in every substep",
           "[contact]") {
-    checkAgainstReference(Drop::FlatOnSphere, false);
+    checkAgainstReference(Drop::FlatOnSphere, true, RotationProjection::Always);
+    checkAgainstReference(Drop::EdgeOnGround, true, RotationProjection::Always);
 }
 
-// Not met yet (issue 25): the strain at one substep per frame is 0.068 against 1.5 × 0.013 + 0.01
-// allowed, and the projection still pushes out up to 0.2 mm; the linearised membrane has no
-// out-of-plane stiffness at a flat start, so the vertices next to the first contacts fall past
-// them within the step.
-TEST_CASE("contact in the solve: the sphere drop's stretch goal", "[.goal][contact]") {
-    checkAgainstReference(Drop::FlatOnSphere, true);
+// Without the projection the contact solve alone holds the weaker bounds (no halving, no retry,
+// the energy goal, push-out within a tenth of the thickness) but not the stretch goal: the
+// sphere's strain is 0.068 against 1.5 × 0.013 + 0.01 allowed; the edges turning about the contact
+// ring end longer than the linearised step saw (docs/solver.md).
+TEST_CASE("contact in the solve: the drops at one substep per frame without the projection",
+          "[contact]") {
+    checkAgainstReference(Drop::FlatOnSphere, false, RotationProjection::Off);
+    checkAgainstReference(Drop::EdgeOnGround, false, RotationProjection::Off);
 }
 
-// With the rotation projection ([solver] rotation_projection, rotation_projection.h) both runs
-// meet every goal of the issue, the stretch one included (without it 1.068 at one substep).
-TEST_CASE("contact in the solve: the drops' goals with the rotation projection", "[contact]") {
-    checkAgainstReference(Drop::FlatOnSphere, true, true);
-    checkAgainstReference(Drop::EdgeOnGround, true, true);
+TEST_CASE("contact in the solve: the sphere drop's stretch goal without the projection",
+          "[.goal][contact]") {
+    checkAgainstReference(Drop::FlatOnSphere, true, RotationProjection::Off);
+}
+
+// "contact" projects in the substeps with a collider contact in the solve and in no other: the
+// drop's free fall is not projected, its impact is; and a sheet swinging down from a pinned edge
+// with no collider (one substep a frame: its edges turn ~10° a step) gives the same bits as with
+// the projection off, while "always" changes them.
+TEST_CASE("contact in the solve: the default rotation projection acts in contact substeps only",
+          "[contact]") {
+    const DropRun drop = runDrop(Drop::FlatOnSphere, 1, 12);
+    REQUIRE(drop.firstContact > 1);
+    int after = 0;
+    for (size_t f = 0; f < drop.rotationSubsteps.size(); ++f) {
+        INFO("frame " << f + 1 << " contacts " << drop.contacts[f]);
+        if (static_cast<int>(f) + 2 < drop.firstContact) CHECK(drop.rotationSubsteps[f] == 0);
+        if (drop.contacts[f] > 0) CHECK(drop.rotationSubsteps[f] == 1);
+        after += drop.rotationSubsteps[f];
+    }
+    CHECK(after > 0);
+
+    const auto swing = [](RotationProjection r) {
+        ClothMaterial m;
+        m.density = 0.1;
+        m.stretch = Param(2000.0);
+        m.lift.value = Param(0.0);
+        m.drag.value = Param(0.0);
+        auto c = std::make_unique<Cloth>(
+            "sheet",
+            makeGrid(0.5, 0.5, 16, 16, Vec3(-0.25, 1.0, 0.0), Vec3::UnitX(), Vec3::UnitZ()), m);
+        PinSet pins;
+        pins.vertices = gridRow(16, 0);
+        c->addPins(pins);
+        c->options().rotationProjection = r;
+        WorldSettings ws;
+        ws.substeps = 1;
+        World w(ws);
+        w.addBody(std::move(c));
+        long edges = 0;
+        int substeps = 0;
+        for (int f = 1; f <= 12; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            edges += fs.bodies[0].rotationEdges;
+            substeps += fs.bodies[0].rotationSubsteps;
+        }
+        return std::make_tuple(VecX(w.bodies()[0]->positions()), edges, substeps);
+    };
+    const auto [xOff, edgesOff, substepsOff] = swing(RotationProjection::Off);
+    const auto [xContact, edgesContact, substepsContact] = swing(RotationProjection::Contact);
+    const auto [xAlways, edgesAlways, substepsAlways] = swing(RotationProjection::Always);
+    CHECK(substepsOff == 0);
+    CHECK(substepsContact == 0);
+    CHECK(edgesContact == 0);
+    CHECK(substepsAlways > 0);
+    CHECK(edgesAlways > 0);
+    CHECK((xContact - xOff).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((xAlways - xOff).cwiseAbs().maxCoeff() > 1e-4);
 }
 
 TEST_CASE("contact in the solve: a sheet resting on the floor comes to rest", "[contact]") {
@@ -194,7 +258,14 @@ TEST_CASE("contact probe: the drop scenes frame by frame", "[.probe]") {
     const char* s = std::getenv("GALE_PROBE_SUBSTEPS");
     const char* d = std::getenv("GALE_PROBE_SCENE");
     runDrop(d && d[0] == '1' ? Drop::EdgeOnGround : Drop::FlatOnSphere, s ? std::atoi(s) : 1, 48,
-            true, std::getenv("GALE_PROBE_ROTATION") != nullptr);
+            true, [] {
+                // GALE_PROBE_ROTATION: off, contact (the default) or always.
+                const char* r = std::getenv("GALE_PROBE_ROTATION");
+                const std::string v = r ? r : "";
+                return v == "off"      ? RotationProjection::Off
+                       : v == "always" ? RotationProjection::Always
+                                       : kDefault;
+            }());
 }
 
 TEST_CASE("contact in the solve: Coulomb friction on an incline at one substep per frame",

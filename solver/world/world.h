@@ -91,6 +91,7 @@ struct BodyFrameStats {
     // summed over the substeps, and the largest excess over the target (× rest).
     long rotationEdges = 0;
     double rotationExcess = 0.0;
+    int rotationSubsteps = 0; // substeps in which it ran
     int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
         projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
