@@ -368,10 +368,11 @@ void Loader::stepOptions(const toml::table& t, const std::string& what, StepOpti
     }
     if (const toml::node* n = t.get("multigrid")) {
         std::string v;
-        if (choice(*n, "multigrid", {"auto", "plain", "smoothed"}, v))
-            s.multigrid = v == "plain"      ? MultigridKind::Plain
-                          : v == "smoothed" ? MultigridKind::Smoothed
-                                            : MultigridKind::Automatic;
+        if (choice(*n, "multigrid", {"auto", "plain", "smoothed", "smoothed-rotations"}, v))
+            s.multigrid = v == "plain"                ? MultigridKind::Plain
+                          : v == "smoothed"           ? MultigridKind::Smoothed
+                          : v == "smoothed-rotations" ? MultigridKind::SmoothedRotations
+                                                      : MultigridKind::Automatic;
     }
     if (const toml::node* n = t.get("cg_tolerance")) number(*n, what + ": cg_tolerance", s.cgTolerance, 0.0, true);
     if (const toml::node* n = t.get("cg_max_iterations")) {

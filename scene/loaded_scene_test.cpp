@@ -154,8 +154,8 @@ TEST_CASE("multigrid: the multigrid key picks plain or smoothed aggregation; a b
         for (const auto& e : errs) errors += e.render() + "\n";
         return ok;
     };
-    SimScene a, b, c, d, e;
-    std::string ea, eb, ec, ed, ee;
+    SimScene a, b, c, d, e, f;
+    std::string ea, eb, ec, ed, ee, ef;
     REQUIRE(load("", a, ea));
     CHECK(a.cloths[0].step.multigrid == MultigridKind::Automatic); // the default
     REQUIRE(load("\"plain\"", b, eb));
@@ -164,6 +164,8 @@ TEST_CASE("multigrid: the multigrid key picks plain or smoothed aggregation; a b
     CHECK(c.cloths[0].step.multigrid == MultigridKind::Smoothed);
     REQUIRE(load("\"auto\"", d, ed));
     CHECK(d.cloths[0].step.multigrid == MultigridKind::Automatic);
+    REQUIRE(load("\"smoothed-rotations\"", f, ef));
+    CHECK(f.cloths[0].step.multigrid == MultigridKind::SmoothedRotations);
     CHECK_FALSE(load("\"sa\"", e, ee));
     INFO(ee);
     CHECK(ee.find(path + ":4:13: error: unknown multigrid 'sa'") != std::string::npos);

@@ -76,7 +76,8 @@ struct StepOptions {
         Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
     // The multigrid's hierarchy: Automatic takes smoothed aggregation from
     // BlockMultigrid::Settings::smoothedMinRows block rows up (its set-up pays only there,
-    // bench/README.md) and plain aggregation below; Plain and Smoothed force one.
+    // bench/README.md) and plain aggregation below; Plain and Smoothed force one;
+    // SmoothedRotations is Smoothed with rotations in the near-null space.
     MultigridKind multigrid = MultigridKind::Automatic;
     double cgTolerance = 1e-3; // relative residual of the filtered system
     int cgMaxIterations = 2000;

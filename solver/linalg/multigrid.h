@@ -19,8 +19,8 @@ struct Constraints;
 
 // How the filtered system is preconditioned inside conjugate gradient.
 enum class Preconditioner { BlockJacobi, Multigrid };
-// Which multigrid hierarchy (BlockMultigrid::Settings::smoothed, smoothedMinRows).
-enum class MultigridKind { Automatic, Plain, Smoothed };
+// Which multigrid hierarchy (BlockMultigrid::Settings::smoothed, smoothedMinRows, rotations).
+enum class MultigridKind { Automatic, Plain, Smoothed, SmoothedRotations };
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
 // column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad
@@ -48,7 +48,8 @@ struct BsrMatrix {
 // with a near-null space B of rigid-body modes filtered by the constraints: for vertex i at x_i
 // in an aggregate with centroid c,
 //   B_i = S_i [ I₃ | −[x_i − c]× / ρ ]   (translations and rotations; ρ the aggregate's radius),
-// or the translations S_i alone when no positions are given (setPositions). Per level:
+// or the translations S_i alone (the default: Settings::rotations off, or no positions given).
+// Per level:
 //   P_tent = blockdiag(Q_J),  B_J = Q_J R_J  (orthonormalised on each aggregate J),
 //   P = (I − ω D⁻¹ Â) P_tent,  ω = (4/3) / ρ(D⁻¹Â)  (ρ by a few power steps),
 //   A_{l+1} = Pᵀ A_l P,   B_{l+1} = R,
@@ -108,7 +109,12 @@ public:
         // meshes costs less than the iterations smoothing saves (bench/README.md, crossover).
         bool smoothed = true;
         int smoothedMinRows = 12000;
-        bool rotations = true;      // rotations in the near-null space (when positions are set)
+        // Rotations in the near-null space (when positions are set). Off by default: with the
+        // translations alone the counts stay as bounded from 32² to 256² (grid, 1/24 s: 8, 9,
+        // 11, 11 against 6, 7, 9, 9), the hierarchy holds 655 B/vertex instead of 1054 and
+        // the wind-onset flag's 256² frame costs 0.37 s instead of 0.62 (bench/README.md,
+        // "Smoothed aggregation with translations only").
+        bool rotations = false;
         double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
         int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
     };
@@ -118,15 +124,23 @@ public:
     static Settings& defaults();
 
     Settings& settings() { return mSettings; }
-    // Sets smoothed and smoothedMinRows for `kind` (Automatic: the defaults' threshold).
+    // Sets smoothed, smoothedMinRows and rotations for `kind` (Automatic: the defaults'
+    // threshold; SmoothedRotations: smoothed at every size with the rotations).
     void setKind(MultigridKind kind) {
         mSettings.smoothed = kind != MultigridKind::Plain;
         mSettings.smoothedMinRows = kind == MultigridKind::Automatic ? defaults().smoothedMinRows : 0;
+        mSettings.rotations = kind == MultigridKind::SmoothedRotations || defaults().rotations;
     }
 
     // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
-    // space; copied. Without them (or with another count) the near-null space is translations.
-    void setPositions(const double* x, int n) { mPositions.assign(x, x + 3 * static_cast<size_t>(n)); }
+    // space; copied when Settings::rotations is on (set it first), else dropped. Without them
+    // (or with another count) the near-null space is translations.
+    void setPositions(const double* x, int n) {
+        if (mSettings.rotations)
+            mPositions.assign(x, x + 3 * static_cast<size_t>(n));
+        else
+            std::vector<double>().swap(mPositions);
+    }
 
     // Builds Â = S A S + I − S into level 0 and the coarse operators; aggregates and colours are
     // built when the pattern of A is new. `constrained` lists A's rows with S ≠ I. Returns false

@@ -334,48 +334,78 @@ MgRun solveMg(const ClothSystem& s, double tol, bool smoothed, bool rotations, i
 
 } // namespace
 
-TEST_CASE("multigrid: smoothed aggregation with rotations agrees with LDLT on irregular sheets",
+TEST_CASE("multigrid: smoothed aggregation, translations alone or with rotations, agrees with "
+          "LDLT on irregular sheets",
           "[multigrid]") {
-    for (bool irregular : {false, true})
-        for (double h : {1.0 / 24.0, 1.0 / 240.0}) {
-            const ClothSystem s = makeClothSystem(24, h, irregular, true);
-            FilteredSolver direct;
-            VecX ref = VecX::Zero(s.b.size());
-            REQUIRE(direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
-            const double tol = 1e-9;
-            const MgRun mg = solveMg(s, tol, true, true);
-            INFO("irregular " << irregular << ", h " << h << ": " << mg.iterations << " iterations");
-            REQUIRE(mg.converged);
-            CHECK(mg.modes == 6);
-            // ‖Δv − Δv*‖ ≤ cond(Â)·tol·‖Δv*‖ in theory; the pinned rows are exact (S = 0).
-            CHECK((mg.dv - ref).norm() <= 1e-6 * ref.norm());
-            for (int v : s.constrained)
-                if (s.c.kind[v] == 1) CHECK((mg.dv - ref).segment<3>(3 * v).norm() == 0.0);
-        }
+    for (bool rotations : {false, true})
+        for (bool irregular : {false, true})
+            for (double h : {1.0 / 24.0, 1.0 / 240.0}) {
+                const ClothSystem s = makeClothSystem(24, h, irregular, true);
+                FilteredSolver direct;
+                VecX ref = VecX::Zero(s.b.size());
+                REQUIRE(
+                    direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
+                const double tol = 1e-9;
+                const MgRun mg = solveMg(s, tol, true, rotations);
+                INFO("rotations " << rotations << ", irregular " << irregular << ", h " << h << ": "
+                                  << mg.iterations << " iterations");
+                REQUIRE(mg.converged);
+                CHECK(mg.modes == (rotations ? 6 : 3));
+                // ‖Δv − Δv*‖ ≤ cond(Â)·tol·‖Δv*‖ in theory; the pinned rows are exact (S = 0).
+                CHECK((mg.dv - ref).norm() <= 1e-6 * ref.norm());
+                for (int v : s.constrained)
+                    if (s.c.kind[v] == 1) CHECK((mg.dv - ref).segment<3>(3 * v).norm() == 0.0);
+            }
 }
 
 TEST_CASE("multigrid: smoothed-aggregation iterations stay bounded from 32x32 to 256x256",
           "[multigrid][scaling][heavy]") {
     // The count at 256² against 32² (8× the resolution, 64× the vertices) at frame-size and
-    // substep-size steps, regular and irregular: smoothed aggregation with rotations stays
-    // within 1.6× (measured 6→9 at worst); plain aggregation on the same systems grows over 2.5×
-    // (20→68), which shows the systems are hard enough for the bound to mean something.
+    // substep-size steps, regular and irregular: smoothed aggregation, with the translations
+    // alone (the default; measured 8→11 at worst) and with rotations (6→9), stays within 1.6×;
+    // plain aggregation on the same systems grows over 2.5× (20→68), which shows the systems are
+    // hard enough for the bound to mean something.
     for (bool irregular : {false, true})
         for (double h : {1.0 / 24.0, 1.0 / 240.0}) {
-            std::vector<int> sa, plain;
+            std::vector<int> sa, rot, plain;
             for (int n : {32, 64, 128, 256}) {
                 const ClothSystem s = makeClothSystem(n, h, irregular, true);
-                const MgRun r = solveMg(s, 1e-3, true, true);
+                const MgRun r = solveMg(s, 1e-3, true, false);
+                const MgRun rr = solveMg(s, 1e-3, true, true);
                 REQUIRE(r.converged);
+                REQUIRE(rr.converged);
+                CHECK(r.modes == 3);
+                CHECK(rr.modes == 6);
                 sa.push_back(r.iterations);
+                rot.push_back(rr.iterations);
                 if (n == 32 || n == 256) plain.push_back(solveMg(s, 1e-3, false, false).iterations);
             }
             INFO("irregular " << irregular << ", h " << h << ": SA " << sa[0] << " " << sa[1] << " "
-                              << sa[2] << " " << sa[3] << ", plain " << plain[0] << " " << plain[1]);
+                              << sa[2] << " " << sa[3] << ", with rotations " << rot[0] << " "
+                              << rot[1] << " " << rot[2] << " " << rot[3] << ", plain " << plain[0]
+                              << " " << plain[1]);
             CHECK(*std::max_element(sa.begin(), sa.end()) <= 1.6 * sa[0]);
+            CHECK(*std::max_element(rot.begin(), rot.end()) <= 1.6 * rot[0]);
             CHECK(sa.back() < plain.back());
             CHECK(plain[1] >= 2.5 * plain[0]);
         }
+}
+
+TEST_CASE("multigrid: setKind picks the hierarchy and its near-null space", "[multigrid]") {
+    const ClothSystem s = makeClothSystem(16, 1.0 / 24.0, true, true);
+    for (MultigridKind kind : {MultigridKind::Automatic, MultigridKind::Plain,
+                               MultigridKind::Smoothed, MultigridKind::SmoothedRotations}) {
+        FilteredSolver mg;
+        mg.setPreconditioner(Preconditioner::Multigrid);
+        mg.multigrid().setKind(kind);
+        mg.multigrid().setPositions(s.x.data(), s.A.size()); // after the kind: kept for rotations
+        VecX dv = VecX::Zero(s.b.size());
+        REQUIRE(mg.solve(s.A, s.c, s.b, dv, LinearSolverKind::Pcg, 1e-8, 1000).converged);
+        INFO("kind " << static_cast<int>(kind));
+        const bool plain = kind == MultigridKind::Automatic || kind == MultigridKind::Plain;
+        CHECK(mg.multigrid().plain() == plain); // 289 vertices: below smoothedMinRows
+        CHECK(mg.multigrid().modes() == (kind == MultigridKind::SmoothedRotations ? 6 : 3));
+    }
 }
 
 TEST_CASE("multigrid: by default plain aggregation below smoothedMinRows, smoothed from there up",
@@ -395,7 +425,7 @@ TEST_CASE("multigrid: by default plain aggregation below smoothedMinRows, smooth
     CHECK(a.plain);
     CHECK(a.modes == 3);
     CHECK_FALSE(b.plain);
-    CHECK(b.modes == 6);
+    CHECK(b.modes == 3); // the translations alone (Settings::rotations off by default)
     // The automatic choice below the threshold is the forced plain path, bit for bit.
     const MgRun forced = solveMg(small, 1e-6, false, false, 1);
     CHECK(forced.plain);
@@ -405,11 +435,13 @@ TEST_CASE("multigrid: by default plain aggregation below smoothedMinRows, smooth
 
 TEST_CASE("multigrid: smoothed aggregation gives the same bits on 1 and 2 threads", "[multigrid]") {
     const ClothSystem s = makeClothSystem(96, 1.0 / 24.0, true, true);
-    const MgRun one = solveMg(s, 1e-8, true, true, 1);
-    const MgRun two = solveMg(s, 1e-8, true, true, 2);
-    REQUIRE(one.converged);
-    CHECK(one.iterations == two.iterations);
-    CHECK((one.dv - two.dv).cwiseAbs().maxCoeff() == 0.0);
+    for (bool rotations : {false, true}) {
+        const MgRun one = solveMg(s, 1e-8, true, rotations, 1);
+        const MgRun two = solveMg(s, 1e-8, true, rotations, 2);
+        REQUIRE(one.converged);
+        CHECK(one.iterations == two.iterations);
+        CHECK((one.dv - two.dv).cwiseAbs().maxCoeff() == 0.0);
+    }
 }
 
 TEST_CASE("multigrid: a fully pinned aggregate and plane filters keep the V-cycle SPD",
@@ -428,9 +460,11 @@ TEST_CASE("multigrid: a fully pinned aggregate and plane filters keep the V-cycl
     FilteredSolver direct;
     VecX ref = VecX::Zero(s.b.size());
     REQUIRE(direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
-    const MgRun mg = solveMg(s, 1e-9, true, true);
-    REQUIRE(mg.converged);
-    CHECK((mg.dv - ref).norm() <= 1e-6 * ref.norm());
+    for (bool rotations : {false, true}) {
+        const MgRun mg = solveMg(s, 1e-9, true, rotations);
+        REQUIRE(mg.converged);
+        CHECK((mg.dv - ref).norm() <= 1e-6 * ref.norm());
+    }
 }
 
 TEST_CASE("multigrid: double products read the assembled matrix; levels are exactly symmetric",
