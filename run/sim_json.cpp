@@ -74,7 +74,8 @@ std::string settingsJson(const scene::SimScene& sc,
       << ", \"grow_back\": " << (sc.solver.growBack ? "true" : "false")
       << ", \"retry_strain_limit\": " << (sc.solver.strainLimit ? "true" : "false")
       << ", \"rotation_projection\": "
-      << jsonString(rotationProjectionName(sc.solver.rotationProjection)) << "}";
+      << jsonString(rotationProjectionName(sc.solver.rotationProjection))
+      << ", \"stretch_limit\": " << num(sc.solver.stretchLimit) << "}";
     o << ", \"fields\": [";
     for (size_t i = 0; i < sc.wind.fields.size(); ++i)
         o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
@@ -167,6 +168,7 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"slid\": " << b.contactSlides << ", \"extra_solves\": " << b.contactSolves
           << "}, \"rotation_projection\": {\"substeps\": " << b.rotationSubsteps
           << ", \"edges\": " << b.rotationEdges << ", \"max_excess\": " << num(b.rotationExcess)
+          << "}, \"stretch_limit\": {\"substeps\": " << b.stretchLimitSubsteps
           << "}, \"contact_projection\": {\"vertices\": " << b.projected
           << ", \"max_distance\": " << num(b.projectedDistance)
           << ", \"max_speed\": " << num(b.projectedSpeed) << "}";

@@ -50,9 +50,9 @@ const std::vector<std::string> kColliderKeys = {
     "name", "type",      "center",   "radius", "point", "normal",   "a",
     "b",    "thickness", "friction", "mesh",   "voxel", "rest_mesh"};
 const std::vector<std::string> kSolverKeys = {
-    "max_halvings",      "over_stretch", "velocity_jump", "retry_newton",      "retry_cg_tolerance",
-    "retry_keep_coarse", "retry_repeat", "grow_back",     "retry_strain_limit",
-    "rotation_projection"};
+    "max_halvings",       "over_stretch",        "velocity_jump", "retry_newton",
+    "retry_cg_tolerance", "retry_keep_coarse",   "retry_repeat",  "grow_back",
+    "retry_strain_limit", "rotation_projection", "stretch_limit"};
 
 class Loader : public TomlReader {
 public:
@@ -699,6 +699,12 @@ void Loader::loadSolver(const toml::table& t, SolverSection& s) {
     if (const toml::node* n = t.get("grow_back")) boolean(*n, "[solver] grow_back", s.growBack);
     if (const toml::node* n = t.get("retry_strain_limit"))
         boolean(*n, "[solver] retry_strain_limit", s.strainLimit);
+    if (const toml::node* n = t.get("stretch_limit")) {
+        // × rest length; 0 turns the limit off, else at least 1.
+        if (number(*n, "[solver] stretch_limit", s.stretchLimit, 0.0, false) &&
+            s.stretchLimit != 0.0 && s.stretchLimit < 1.0)
+            error(*n, "[solver] stretch_limit must be 0 (no limit) or at least 1 (× rest length)");
+    }
     if (const toml::node* n = t.get("rotation_projection")) {
         // "off", "contact" (the default) or "always"; false and true stand for off and always.
         std::string v;

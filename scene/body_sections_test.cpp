@@ -278,6 +278,25 @@ grow_back = "yes"
           std::string::npos);
 }
 
+TEST_CASE("scene: [solver] stretch_limit is 0 (none, the default) or at least 1", "[scene]") {
+    TempDir dir;
+    const auto with = [&](const std::string& value) {
+        return load(dir, "[[cloth]]\nname = \"c\"\ngrid = { size = [1, 1], res = [4, 4] }\n" +
+                             (value.empty() ? "" : "[solver]\nstretch_limit = " + value + "\n"));
+    };
+    const Loaded none = with("");
+    REQUIRE(none.ok);
+    CHECK(none.scene.solver.stretchLimit == 0.0);
+    const Loaded limit = with("1.5");
+    REQUIRE(limit.ok);
+    CHECK(limit.scene.solver.stretchLimit == 1.5);
+    const Loaded bad = with("0.5");
+    CHECK_FALSE(bad.ok);
+    const std::string path = (dir.path / "scene.toml").string();
+    CHECK(bad.all().find(path + ":5:17: error: [solver] stretch_limit must be 0 (no limit) or at "
+                                "least 1") != std::string::npos);
+}
+
 TEST_CASE("scene: [solver] rotation_projection is off, contact (the default) or always",
           "[scene]") {
     TempDir dir;

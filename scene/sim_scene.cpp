@@ -391,6 +391,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         cloth->collision() = spec.collision;
         cloth->limits().overStretch = scene.solver.overStretch;
         cloth->options().rotationProjection = scene.solver.rotationProjection;
+        cloth->options().stretchLimit = scene.solver.stretchLimit;
         cloth->limits().velocityJump = scene.solver.velocityJump;
         if (cloth->degenerateTriangles())
             warnings.push_back(what + ": " + std::to_string(cloth->degenerateTriangles()) +
@@ -516,6 +517,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         hair->collision().self = spec.collideCloth;
         hair->limits().overStretch = scene.solver.overStretch;
         hair->options().rotationProjection = scene.solver.rotationProjection;
+        hair->options().stretchLimit = scene.solver.stretchLimit;
         hair->limits().velocityJump = scene.solver.velocityJump;
         bodies.push_back(std::move(hair));
     }

@@ -111,6 +111,8 @@ struct SolverSection {
     // When the length a linearised step's rotations add is projected out of every body's edges
     // (solver::StepOptions::rotationProjection): "off", "contact" (default) or "always".
     solver::RotationProjection rotationProjection = solver::StepOptions{}.rotationProjection;
+    // Strain limit of every body's edges (× rest; 0: none; solver::StepOptions::stretchLimit).
+    double stretchLimit = solver::StepOptions{}.stretchLimit;
 };
 
 struct SimScene {

@@ -603,10 +603,17 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     }
     // 5b. ... else the length the linearised step's rotations added, projected out
     // (rotation_projection.h).
-    if (st.converged && !mOptions.explicitEuler && st.newtonIterations == 0 &&
-        (mOptions.rotationProjection == RotationProjection::Always ||
-         (mOptions.rotationProjection == RotationProjection::Contact && colliderHolds())))
-        projectRotations(x0, v0, h, st);
+    // ... and, whatever ran, the strain limit (StepOptions::stretchLimit).
+    if (st.converged && !mOptions.explicitEuler) {
+        const bool rotations =
+            st.newtonIterations == 0 &&
+            (mOptions.rotationProjection == RotationProjection::Always ||
+             (mOptions.rotationProjection == RotationProjection::Contact && colliderHolds()));
+        const bool limit = mOptions.stretchLimit > 0.0 && !mEdges.empty() &&
+                           maxEdgeStretchOf(x0 + h * (v0 + mDv) + mYPos) > mOptions.stretchLimit;
+        if (rotations || limit)
+            projectRotations(x0, v0, h, st, rotations, limit ? mOptions.stretchLimit : 0.0);
+    }
     mDvGuess = mDv;
     mHGuess = h;
     mV = v0 + mDv;
@@ -687,7 +694,8 @@ bool Body::colliderHolds() const {
 // collider's surface (its tangent plane there), and afterwards back out to the distance it had
 // where a curved surface came closer: the projection leaves the push-out after the solve
 // nothing to do.
-void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st) {
+void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st,
+                            bool rotations, double stretchLimit) {
     constexpr double kHoldMargin = 0.01; // m
     // Vertex v's end position with velocity change dv.
     const auto endOf = [&](const VecX& dv, size_t v) {
@@ -712,7 +720,7 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
     const VecX dvBefore = mDv;
     const RotationProjectionStats ps =
         projectRotationLength(mEdges, mEdgeRest, mMass, mConstraints, x0, v0, mYPos, h, mDv,
-                              mOptions.rotationTolerance, hold);
+                              mOptions.rotationTolerance, hold, rotations, stretchLimit);
     // Every vertex it moved that a collider's surface came closer to (a curved one under a
     // contact sliding in its plane, or under a vertex moving in the tangent plane of its
     // nearest point): back out along the normal to the distance it had, or to the thickness.
@@ -731,7 +739,8 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
                 vec3At(mDv.data(), v) += ((floor - after.distance) / h) * after.normal;
         }
     }
-    st.rotationProjected = true;
+    st.rotationProjected = rotations;
+    st.stretchLimited = stretchLimit > 0.0;
     st.rotationEdges = ps.activeEdges;
     st.rotationExcess = ps.excessBefore;
 }

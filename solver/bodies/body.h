@@ -107,6 +107,10 @@ struct StepOptions {
     // projecting there costs 1.7–2.6× the step (bench/README.md).
     RotationProjection rotationProjection = RotationProjection::Contact;
     double rotationTolerance = 1e-3;
+    // Strain limit (× rest length; 0: none): a substep whose step would end with an edge longer
+    // than this projects every such edge back to it, by the same projection (Provot 1995's
+    // limit, solved as Goldenthal et al. 2007 do; [solver] stretch_limit).
+    double stretchLimit = 0.0;
 };
 
 // What a substep sees of the world.
@@ -180,6 +184,7 @@ struct SubstepStatus {
     int rotationEdges = 0;
     double rotationExcess = 0.0;
     bool rotationProjected = false; // the projection ran in this substep
+    bool stretchLimited = false;    // ... for edges beyond StepOptions::stretchLimit
     int projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
 };
@@ -371,7 +376,8 @@ private:
     // The rotation-length projection of the linearised step (rotation_projection.h), and whether
     // a collider holds a vertex in the solve (RotationProjection::Contact runs it then).
     bool colliderHolds() const;
-    void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st);
+    void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st,
+                          bool rotations, double stretchLimit);
     double slipOf(size_t i, const VecX& v0) const;
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);

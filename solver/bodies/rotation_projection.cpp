@@ -15,18 +15,18 @@ namespace gale::solver {
 
 namespace {
 constexpr int kMaxIterations = 6;        // Gauss–Newton iterations
+constexpr int kMaxLimitIterations = 30;  // ... with a stretch limit (a bound, not a correction)
 constexpr int kMaxCg = 60;               // CG iterations per Gauss–Newton iteration
 constexpr double kCgTolerance = 1e-3;    // relative residual of each linear solve
 constexpr double kRegularisation = 1e-2; // α relative to the mean diagonal of J W Jᵀ
 constexpr int kMaxCuts = 10;             // step halvings of the merit's line search
 } // namespace
 
-RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 2>>& edges,
-                                              const std::vector<double>& rest, const VecX& mass,
-                                              const Constraints& constraints, const VecX& x0,
-                                              const VecX& v0, const VecX& y, double h, VecX& dv,
-                                              double tolerance,
-                                              const std::function<Vec3(int)>& hold) {
+RotationProjectionStats
+projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::vector<double>& rest,
+                      const VecX& mass, const Constraints& constraints, const VecX& x0,
+                      const VecX& v0, const VecX& y, double h, VecX& dv, double tolerance,
+                      const std::function<Vec3(int)>& hold, bool rotations, double stretchLimit) {
     RotationProjectionStats stats;
     const size_t n = static_cast<size_t>(mass.size());
     VecX x = x0 + h * (v0 + dv) + y;
@@ -39,7 +39,10 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
         const auto [a, b] = edges[e];
         const Vec3 d0 = at(x0, b) - at(x0, a), d1 = at(x, b) - at(x, a);
         const double l0 = d0.norm();
-        target[e] = l0 > 0.0 ? std::max(rest[e], d0.dot(d1) / l0) : rest[e];
+        target[e] = !rotations ? INFINITY : l0 > 0.0 ? std::max(rest[e], d0.dot(d1) / l0) : rest[e];
+        // Below the cap by the tolerance: an edge is left alone within it of its target.
+        if (stretchLimit > 0.0)
+            target[e] = std::min(target[e], (stretchLimit - tolerance) * rest[e]);
         if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
         const double excess = (d1.norm() - target[e]) / rest[e];
         worst = std::max(worst, excess);
@@ -83,7 +86,8 @@ RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 
     std::vector<Vec3> dir, u;
     std::vector<double> c, lambda, r, z, p, q, diag;
     VecX trial;
-    for (int it = 0; it < kMaxIterations; ++it) {
+    const int maxIterations = stretchLimit > 0.0 ? kMaxLimitIterations : kMaxIterations;
+    for (int it = 0; it < maxIterations; ++it) {
         active.clear();
         dir.clear();
         c.clear();

@@ -23,17 +23,19 @@ struct RotationProjectionStats {
     double excessBefore = 0.0, excessAfter = 0.0; // largest (length − target) / rest
 };
 
-// x₁ = x₀ + h (v₀ + Δv) + y; Δv is changed in place. mass: per vertex (kg); the constraint
-// constraint filter S limits a vertex's motion (a pin or attachment moves not at all, a contact
-// only in its plane); a free one near a collider
-// (hold(i), asked only for the vertices of active edges: the collider's normal there, zero
-// when none) only in the plane of that normal. tolerance: relative excess (× rest) below which
-// an edge is left alone.
+// x₁ = x₀ + h (v₀ + Δv) + y; Δv is changed in place. rotations: targets max(L, d̂₀·d₁) (else
+// none); stretchLimit > 0 caps every target at stretchLimit × L (strain limiting: with
+// rotations off, only the edges beyond the cap are projected). mass: per vertex (kg); the
+// constraint constraint filter S limits a vertex's motion (a pin or attachment moves not at all, a
+// contact only in its plane); a free one near a collider (hold(i), asked only for the vertices of
+// active edges: the collider's normal there, zero when none) only in the plane of that normal.
+// tolerance: relative excess (× rest) below which an edge is left alone.
 RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 2>>& edges,
                                               const std::vector<double>& rest, const VecX& mass,
                                               const Constraints& constraints, const VecX& x0,
                                               const VecX& v0, const VecX& y, double h, VecX& dv,
                                               double tolerance,
-                                              const std::function<Vec3(int)>& hold = {});
+                                              const std::function<Vec3(int)>& hold = {},
+                                              bool rotations = true, double stretchLimit = 0.0);
 
 } // namespace gale::solver

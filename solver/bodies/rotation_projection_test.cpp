@@ -65,3 +65,42 @@ TEST_CASE("rotation projection: a stretch the step saw is not undone", "[rotatio
     projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6);
     CHECK((e.end(1) - e.end(0)).norm() == Approx(0.105).epsilon(1e-5));
 }
+
+TEST_CASE("stretch limit: an edge the step stretched along itself comes back to the limit",
+          "[rotation]") {
+    OneEdge e;
+    e.c.kind[0] = 1; // pinned
+    // 80 % along the edge, no turn: the rotation targets keep it, the limit 1.5 does not.
+    e.dv.segment<3>(3) = Vec3(0.08, 0.0, 0.0) / e.h;
+    const double tol = 1e-4;
+    {
+        OneEdge kept = e;
+        const RotationProjectionStats s =
+            projectRotationLength(kept.edges, kept.rest, kept.mass, kept.c, kept.x0, kept.v0,
+                                  kept.y, kept.h, kept.dv, tol, {}, true, 0.0);
+        CHECK(s.activeEdges == 0);
+        CHECK(kept.end(1).x() == Approx(0.18).epsilon(1e-12));
+    }
+    const RotationProjectionStats s = projectRotationLength(
+        e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, tol, {}, false, 1.5);
+    CHECK(s.activeEdges == 1);
+    CHECK(e.end(0).norm() == 0.0);
+    // Along the edge, from the pin: at most 1.5 × rest, within the tolerance below it.
+    const double len = e.end(1).norm();
+    CHECK(len <= 0.15);
+    CHECK(len >= 0.15 - 2.0 * tol * 0.1);
+    CHECK(std::abs(e.end(1).y()) < 1e-12);
+    // The velocity follows the position: the free end's Δv is what brings it there in h.
+    CHECK(e.dv[3] == Approx((e.end(1).x() - e.x0[3]) / e.h).epsilon(1e-12));
+}
+
+TEST_CASE("stretch limit: with rotations off, only edges beyond the limit move", "[rotation]") {
+    OneEdge e;
+    // Turned within the step (4.4 % longer than rest, below the limit): left as it is.
+    e.dv.segment<3>(3) = Vec3(0.0, 0.03, 0.0) / e.h;
+    const VecX before = e.dv;
+    const RotationProjectionStats s = projectRotationLength(
+        e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-6, {}, false, 1.5);
+    CHECK(s.activeEdges == 0);
+    CHECK(e.dv == before);
+}

@@ -431,6 +431,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         stats.rotationEdges += st.rotationEdges;
         stats.rotationExcess = std::max(stats.rotationExcess, st.rotationExcess);
         stats.rotationSubsteps += st.rotationProjected ? 1 : 0;
+        stats.stretchLimitSubsteps += st.stretchLimited ? 1 : 0;
         stats.contactAdded += st.contactAdded;
         stats.contactReleases += st.contactReleases;
         stats.contactSlides += st.contactSlides;

@@ -92,6 +92,7 @@ struct BodyFrameStats {
     long rotationEdges = 0;
     double rotationExcess = 0.0;
     int rotationSubsteps = 0; // substeps in which it ran
+    int stretchLimitSubsteps = 0; // substeps the strain limit ([solver] stretch_limit) acted in
     int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
         projected = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
