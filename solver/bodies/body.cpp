@@ -608,7 +608,8 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         const bool rotations =
             st.newtonIterations == 0 &&
             (mOptions.rotationProjection == RotationProjection::Always ||
-             (mOptions.rotationProjection == RotationProjection::Contact && colliderHolds()));
+             (mOptions.rotationProjection == RotationProjection::Contact &&
+              st.contactConstraints > st.clothConstraints)); // a collider holds a vertex
         const bool limit = mOptions.stretchLimit > 0.0 && !mEdges.empty() &&
                            maxEdgeStretchOf(x0 + h * (v0 + mDv) + mYPos) > mOptions.stretchLimit;
         if (rotations || limit)
@@ -681,12 +682,6 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         }
     }
     return st;
-}
-
-bool Body::colliderHolds() const {
-    const int colliders = static_cast<int>(mKin.colliders.size()); // beyond: cloth planes
-    return std::any_of(mContactCollider.begin(), mContactCollider.end(),
-                       [&](int c) { return c >= 0 && c < colliders; });
 }
 
 // The rotation-length projection of the linearised step (rotation_projection.h). A free vertex

@@ -373,9 +373,7 @@ private:
     void landed();
     void rememberSliding(const VecX& v0, double h);
     void slide(size_t i, double c);
-    // The rotation-length projection of the linearised step (rotation_projection.h), and whether
-    // a collider holds a vertex in the solve (RotationProjection::Contact runs it then).
-    bool colliderHolds() const;
+    // The rotation-length projection of the linearised step (rotation_projection.h).
     void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st,
                           bool rotations, double stretchLimit);
     double slipOf(size_t i, const VecX& v0) const;
