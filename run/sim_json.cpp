@@ -41,11 +41,7 @@ std::string stepJson(const solver::StepOptions& s) {
            ", \"cg_max_iterations\": " + std::to_string(s.cgMaxIterations) +
            ", \"preconditioner\": \"" +
            (s.preconditioner == solver::Preconditioner::Multigrid ? "multigrid" : "jacobi") +
-           "\", \"multigrid\": \"" +
-           (s.multigrid == solver::MultigridKind::Plain               ? "plain"
-            : s.multigrid == solver::MultigridKind::Smoothed          ? "smoothed"
-            : s.multigrid == solver::MultigridKind::SmoothedRotations ? "smoothed-rotations"
-                                                                      : "auto") +
+           "\", \"multigrid\": \"" + solver::multigridKindName(s.multigrid) +
            "\", \"newton_iterations\": " + std::to_string(s.newtonIterations) +
            ", \"newton_tolerance\": " + num(s.newtonTolerance);
 }

@@ -66,6 +66,18 @@ private:
     bool number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin);
     bool choice(const toml::node& n, const std::string& what, const std::vector<std::string>& options,
                 std::string& out);
+    // choice() among the names of `values` (name(value), the names run.json writes).
+    template <class E>
+    bool named(const toml::node& n, const std::string& what, std::initializer_list<E> values,
+               const char* (*name)(E), E& out) {
+        std::vector<std::string> options;
+        for (E e : values) options.push_back(name(e));
+        std::string v;
+        if (!choice(n, what, options, v)) return false;
+        for (E e : values)
+            if (v == name(e)) out = e;
+        return true;
+    }
     bool boolean(const toml::node& n, const std::string& what, bool& out);
     bool vec3(const toml::node& n, const std::string& what, Vec3& out);
     bool numbers(const toml::node& n, const std::string& what, size_t count, std::vector<double>& out);
@@ -366,14 +378,11 @@ void Loader::stepOptions(const toml::table& t, const std::string& what, StepOpti
         if (choice(*n, "preconditioner", {"multigrid", "jacobi"}, v))
             s.preconditioner = v == "jacobi" ? Preconditioner::BlockJacobi : Preconditioner::Multigrid;
     }
-    if (const toml::node* n = t.get("multigrid")) {
-        std::string v;
-        if (choice(*n, "multigrid", {"auto", "plain", "smoothed", "smoothed-rotations"}, v))
-            s.multigrid = v == "plain"                ? MultigridKind::Plain
-                          : v == "smoothed"           ? MultigridKind::Smoothed
-                          : v == "smoothed-rotations" ? MultigridKind::SmoothedRotations
-                                                      : MultigridKind::Automatic;
-    }
+    if (const toml::node* n = t.get("multigrid"))
+        named(*n, "multigrid",
+              {MultigridKind::Automatic, MultigridKind::Plain, MultigridKind::Smoothed,
+               MultigridKind::SmoothedRotations},
+              multigridKindName, s.multigrid);
     if (const toml::node* n = t.get("cg_tolerance")) number(*n, what + ": cg_tolerance", s.cgTolerance, 0.0, true);
     if (const toml::node* n = t.get("cg_max_iterations")) {
         long long v = 0;
@@ -707,19 +716,19 @@ void Loader::loadSolver(const toml::table& t, SolverSection& s) {
     }
     if (const toml::node* n = t.get("rotation_projection")) {
         // "off", "contact" (the default) or "always"; false and true stand for off and always.
-        std::string v;
+        using solver::RotationProjection;
         if (n->is_boolean())
-            v = n->value<bool>().value_or(false) ? "always" : "off";
-        else if (!n->is_string()) {
+            s.rotationProjection = n->value<bool>().value_or(false) ? RotationProjection::Always
+                                                                    : RotationProjection::Off;
+        else if (!n->is_string())
             error(*n, std::string("[solver] rotation_projection must be \"off\", \"contact\" or "
                                   "\"always\" (or false, true), not ") +
                           tomlTypeName(*n));
-            return;
-        } else if (!choice(*n, "[solver] rotation_projection", {"off", "contact", "always"}, v))
-            return;
-        s.rotationProjection = v == "off"       ? solver::RotationProjection::Off
-                               : v == "contact" ? solver::RotationProjection::Contact
-                                                : solver::RotationProjection::Always;
+        else
+            named(
+                *n, "[solver] rotation_projection",
+                {RotationProjection::Off, RotationProjection::Contact, RotationProjection::Always},
+                rotationProjectionName, s.rotationProjection);
     }
 }
 

@@ -21,6 +21,13 @@ struct Constraints;
 enum class Preconditioner { BlockJacobi, Multigrid };
 // Which multigrid hierarchy (BlockMultigrid::Settings::smoothed, smoothedMinRows, rotations).
 enum class MultigridKind { Automatic, Plain, Smoothed, SmoothedRotations };
+// The scene key's value of each kind: "auto", "plain", "smoothed", "smoothed-rotations".
+inline const char* multigridKindName(MultigridKind k) {
+    return k == MultigridKind::Plain               ? "plain"
+           : k == MultigridKind::Smoothed          ? "smoothed"
+           : k == MultigridKind::SmoothedRotations ? "smoothed-rotations"
+                                                   : "auto";
+}
 
 // A symmetric 3×3-block sparse matrix in block CSR: block k of row i is val[9k .. 9k+8],
 // column-major, column cols[k]; columns sorted, the diagonal present; val ends in kBsrPad

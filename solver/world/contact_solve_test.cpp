@@ -261,10 +261,10 @@ TEST_CASE("contact probe: the drop scenes frame by frame", "[.probe]") {
             true, [] {
                 // GALE_PROBE_ROTATION: off, contact (the default) or always.
                 const char* r = std::getenv("GALE_PROBE_ROTATION");
-                const std::string v = r ? r : "";
-                return v == "off"      ? RotationProjection::Off
-                       : v == "always" ? RotationProjection::Always
-                                       : kDefault;
+                for (RotationProjection m : {RotationProjection::Off, RotationProjection::Contact,
+                                             RotationProjection::Always})
+                    if (r && std::string(r) == rotationProjectionName(m)) return m;
+                return kDefault;
             }());
 }
 
