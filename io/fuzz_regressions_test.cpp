@@ -124,3 +124,45 @@ TEST_CASE("a PLY element without properties holds no data, whatever its count",
         CHECK(ps.faces[0] == std::vector<int>{2, 1, 0});
     }
 }
+
+// fuzz_readers: a face list's length was trusted before its items were read: a binary list of
+// length 7e8 in a file of a few bytes reserved 2.9 GB (libFuzzer's out-of-memory in CI). A list
+// cannot hold more items than the bytes left; the error names the element and the property.
+TEST_CASE("a PLY list longer than the file is an error before anything is allocated",
+          "[fuzz][pointset][ply]") {
+    for (const char* format : {"ascii", "binary_little_endian"}) {
+        std::string text = std::string("ply\nformat ") + format +
+                           " 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 1\n"
+                           "property list uint int vertex_indices\nend_header\n";
+        const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        if (std::string(format) == "ascii") {
+            text += "0 0 0\n1 0 0\n0 1 0\n717818799 2 1 0\n";
+        } else {
+            text.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+            const unsigned n = 717818799u;
+            const int idx[3] = {2, 1, 0};
+            text.append(reinterpret_cast<const char*>(&n), sizeof n);
+            text.append(reinterpret_cast<const char*>(idx), sizeof idx);
+        }
+        std::istringstream in(text);
+        PointSet ps;
+        IoError e = readPointsPly(in, "long_list.ply", ps);
+        INFO(format << ": " << e.render());
+        REQUIRE(e);
+        CHECK(e.render().find("list length 717818799 in face 0") != std::string::npos);
+        CHECK(e.render().find("more than the file holds") != std::string::npos);
+    }
+    // A list as long as its items still reads.
+    std::string ok = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                     "property float y\nproperty float z\nelement face 1\n"
+                     "property list uint int vertex_indices\nend_header\n"
+                     "0 0 0\n1 0 0\n0 1 0\n3 2 1 0";
+    std::istringstream in(ok);
+    PointSet ps;
+    IoError e = readPointsPly(in, "ok.ply", ps);
+    INFO(e.render());
+    REQUIRE(!e);
+    REQUIRE(ps.faces.size() == 1);
+    CHECK(ps.faces[0] == std::vector<int>{2, 1, 0});
+}

@@ -420,6 +420,15 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                                      "bad list length " + formatNumber(v) + " in " + e.name + " " +
                                          std::to_string(i) + " (property '" + p.name + "')");
                 size_t len = static_cast<size_t>(v);
+                // As for the element counts: a list cannot hold more items than the bytes
+                // left (a fuzzed length of 7e8 asked for 2.9 GB before the first item).
+                const size_t itemSize = body.ascii() ? 2 : plyTypeSize(p.type);
+                if (len > (body.remaining() + 1) / itemSize)
+                    return dataError(name, body.ascii() ? body.line() : 0,
+                                     body.ascii() ? body.col() : 0,
+                                     "list length " + formatNumber(v) + " in " + e.name + " " +
+                                         std::to_string(i) + " (property '" + p.name +
+                                         "') is more than the file holds");
                 std::vector<int> face;
                 if (p.faceIndices) face.reserve(len);
                 for (size_t k = 0; k < len; ++k) {
