@@ -149,4 +149,35 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
     return pairs;
 }
 
+std::vector<std::pair<int, int>> crossingSegments(const std::vector<double>& x,
+                                                  const std::vector<std::array<int, 2>>& segments,
+                                                  const std::vector<double>& y,
+                                                  const std::vector<std::array<int, 3>>& triangles,
+                                                  size_t limit) {
+    std::vector<std::pair<int, int>> pairs;
+    if (segments.empty() || triangles.empty()) return pairs;
+    const auto at = [](const std::vector<double>& p, int v) {
+        return Vec3(p[3 * v], p[3 * v + 1], p[3 * v + 2]);
+    };
+    std::vector<Box> boxes(triangles.size());
+    for (size_t i = 0; i < triangles.size(); ++i)
+        for (int k = 0; k < 3; ++k) boxes[i].add(at(y, triangles[i][k]));
+    Bvh tree;
+    tree.build(boxes);
+    for (size_t s = 0; s < segments.size(); ++s) {
+        const Vec3 p = at(x, segments[s][0]), q = at(x, segments[s][1]);
+        Box box;
+        box.add(p);
+        box.add(q);
+        tree.query(box, [&](int t) {
+            if (limit > 0 && pairs.size() >= limit) return;
+            const auto& tri = triangles[static_cast<size_t>(t)];
+            if (segmentCrossesTriangle(p, q, at(y, tri[0]), at(y, tri[1]), at(y, tri[2])))
+                pairs.emplace_back(static_cast<int>(s), t);
+        });
+        if (limit > 0 && pairs.size() >= limit) break;
+    }
+    return pairs;
+}
+
 } // namespace gale::solver::contact

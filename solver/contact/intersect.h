@@ -48,4 +48,13 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<double>& x,
                                                    const std::vector<std::array<int, 3>>& triangles,
                                                    Bvh& tree, size_t limit = 0);
 
+// The segments (x's edges, e.g. a hair's) that cross a triangle of another mesh (positions y,
+// `triangles`), as (segment, triangle) pairs by segmentCrossesTriangle, in segment order (each
+// segment's triangles in the tree's order); `limit` > 0 stops after that many pairs.
+std::vector<std::pair<int, int>> crossingSegments(const std::vector<double>& x,
+                                                  const std::vector<std::array<int, 2>>& segments,
+                                                  const std::vector<double>& y,
+                                                  const std::vector<std::array<int, 3>>& triangles,
+                                                  size_t limit = 0);
+
 } // namespace gale::solver::contact

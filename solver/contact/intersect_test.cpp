@@ -147,3 +147,62 @@ TEST_CASE("intersect: a crumpled mesh's pairs match brute force", "[contact][int
     CHECK(sharedVertexHits > 0);
     CHECK(intersectingPairs(x, tris, 3).size() == 3);
 }
+
+TEST_CASE("intersect: strands through a crumpled sheet match the independent test",
+          "[contact][intersect]") {
+    // A 10 × 10 crumpled sheet and 40 random strands of 6 segments hanging through it: the
+    // (segment, triangle) crossings against the crossing point's barycentric coordinates over
+    // every pair (pairs too close to a decision boundary for either test to be sure left out).
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    const int n = 10;
+    std::vector<double> y;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            y.push_back(i * 0.1 + 0.03 * U(rng));
+            y.push_back(0.05 * U(rng));
+            y.push_back(j * 0.1 + 0.03 * U(rng));
+        }
+    std::vector<std::array<int, 3>> tris;
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const int a = j * n + i;
+            tris.push_back({a, a + 1, a + n});
+            tris.push_back({a + 1, a + n + 1, a + n});
+        }
+    std::vector<double> x;
+    std::vector<std::array<int, 2>> segs;
+    for (int s = 0; s < 40; ++s) {
+        Vec3 p(0.45 + 0.45 * U(rng), 0.25, 0.45 + 0.45 * U(rng));
+        for (int k = 0; k <= 6; ++k) {
+            if (k > 0)
+                segs.push_back(
+                    {static_cast<int>(x.size() / 3) - 1, static_cast<int>(x.size() / 3)});
+            for (int c = 0; c < 3; ++c) x.push_back(p[c]);
+            p += Vec3(0.03 * U(rng), -0.08, 0.03 * U(rng));
+        }
+    }
+    const auto got = crossingSegments(x, segs, y, tris);
+    const auto at = [](const std::vector<double>& v, int i) {
+        return Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    };
+    int compared = 0, crossings = 0;
+    for (size_t s = 0; s < segs.size(); ++s)
+        for (size_t t = 0; t < tris.size(); ++t) {
+            double margin = 0.0;
+            const bool want =
+                referenceSegment(at(x, segs[s][0]), at(x, segs[s][1]), at(y, tris[t][0]),
+                                 at(y, tris[t][1]), at(y, tris[t][2]), margin);
+            if (margin < 1e-9) continue;
+            ++compared;
+            crossings += want;
+            const bool found = std::find(got.begin(), got.end(),
+                                         std::pair<int, int>(static_cast<int>(s),
+                                                             static_cast<int>(t))) != got.end();
+            INFO("segment " << s << " triangle " << t);
+            REQUIRE(found == want);
+        }
+    CHECK(compared > 30000);
+    CHECK(crossings >= 35); // nearly every strand goes through the sheet once
+    CHECK(crossingSegments(x, segs, y, tris, 5).size() == 5);
+}

@@ -3,6 +3,7 @@
 #include "solver/world/world.h"
 
 #include "solver/collider/moving_collider.h"
+#include "solver/contact/intersect.h"
 #include "solver/mesh/mesh_sequence.h"
 
 #include <tbb/info.h>
@@ -135,6 +136,34 @@ void World::setUpSelfCollision(FrameStats& fs) {
                       "remove them)",
                       start[k]);
         fs.bodies[mSelfBodies[k]].events.push_back(buf);
+    }
+    // A hair that starts through a cloth (segments crossing its triangles): the same, and its
+    // contact with that cloth then holds each such segment where it crosses, which can stretch
+    // the hair as the cloth moves away (the hard scenes' hair at 70×: docs/solver.md).
+    for (size_t h = mClothBodies; h < mSelfBodies.size(); ++h) {
+        const Body& hair = *mBodies[mSelfBodies[h]];
+        const std::vector<double> x(hair.positions().data(),
+                                    hair.positions().data() + hair.positions().size());
+        for (size_t k = 0; k < mClothBodies; ++k) {
+            const Body& cloth = *mBodies[mSelfBodies[k]];
+            const std::vector<double> y(cloth.positions().data(),
+                                        cloth.positions().data() + cloth.positions().size());
+            const auto through =
+                contact::crossingSegments(x, hair.edges(), y, *cloth.collisionTriangles());
+            if (through.empty()) continue;
+            std::vector<uint8_t> seen(hair.edges().size(), 0);
+            int segments = 0;
+            for (const auto& [seg, tri] : through) segments += !seen[seg]++;
+            const auto [a, b] = hair.edges()[static_cast<size_t>(through[0].first)];
+            const Vec3 at = 0.5 * (vec3At(hair.positions().data(), static_cast<size_t>(a)) +
+                                   vec3At(hair.positions().data(), static_cast<size_t>(b)));
+            std::snprintf(buf, sizeof buf,
+                          "hair-cloth collision: the start shape has %d segment(s) through cloth "
+                          "'%s' (the first, %d-%d, at (%.4g, %.4g, %.4g)); contact holds each "
+                          "where it crosses (start the hair clear of the cloth)",
+                          segments, cloth.name().c_str(), a, b, at.x(), at.y(), at.z());
+            fs.bodies[mSelfBodies[h]].events.push_back(buf);
+        }
     }
 }
 
