@@ -166,3 +166,20 @@ TEST_CASE("a PLY list longer than the file is an error before anything is alloca
     REQUIRE(ps.faces.size() == 1);
     CHECK(ps.faces[0] == std::vector<int>{2, 1, 0});
 }
+
+// fuzz_readers: a vertex element without properties and a count of 1e10 allocated its (empty)
+// columns' template, 1e10 doubles, before the count was checked against anything (ASan's
+// out-of-memory). It holds no data: read as no columns, whatever its count.
+TEST_CASE("a PLY vertex element without properties allocates nothing, whatever its count",
+          "[fuzz][pointset][ply]") {
+    for (const char* format : {"ascii", "binary_little_endian"}) {
+        const std::string text =
+            std::string("ply\nformat ") + format + " 1.0\nelement vertex 10455446300\nend_header\n";
+        std::istringstream in(text);
+        PointSet ps;
+        IoError e = readPointsPly(in, "no_properties.ply", ps);
+        INFO(format << ": " << e.render());
+        CHECK(ps.columns.empty());
+        CHECK(ps.size() == 0);
+    }
+}

@@ -383,7 +383,11 @@ IoError readPointsPly(std::istream& in, const std::string& name, PointSet& out) 
                         " elements, more than the file holds");
         }
         bool isVertex = &e == vertex;
-        if (isVertex) out.columns.assign(out.names.size(), std::vector<double>(e.count));
+        // (Columns only for properties: a vertex element without any holds no data, and its
+        // count, checked against the file only when it has properties, may be anything.)
+        if (isVertex)
+            out.columns.assign(out.names.size(),
+                               std::vector<double>(out.names.empty() ? 0 : e.count));
         // An element without properties holds no bytes, whatever its count says (a fuzzed
         // header declared 4.8e18 of them: walking them one by one never ended).
         if (e.props.empty()) continue;
