@@ -198,6 +198,7 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"zone_vertices\": " << s.zoneVertices
           << ", \"frozen_vertices\": " << s.frozenVertices << ", \"unresolved\": " << s.unresolved
           << ", \"start_touching\": " << s.startTouching
+          << ", \"tangled_hair_vertices\": " << s.tangledHairVertices
           << ", \"seconds\": {\"broad\": " << num(s.broadSeconds)
           << ", \"proximity\": " << num(s.proximitySeconds) << ", \"ccd\": " << num(s.ccdSeconds)
           << ", \"fail_safe\": " << num(s.failSafeSeconds) << "}}";

@@ -51,6 +51,7 @@ void SelfCollisionStats::add(const SelfCollisionStats& o) {
     frozenVertices += o.frozenVertices;
     unresolved += o.unresolved;
     startTouching = std::max(startTouching, o.startTouching);
+    tangledHairVertices = std::max(tangledHairVertices, o.tangledHairVertices);
     broadSeconds += o.broadSeconds;
     proximitySeconds += o.proximitySeconds;
     ccdSeconds += o.ccdSeconds;
@@ -594,12 +595,46 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
     mStats.failSafeSeconds += seconds(start);
 }
 
+void SelfCollision::setUntangleHair(bool on) {
+    mUntangleHair = on;
+    if (!on && !mTangled.empty()) {
+        mTangled.clear();
+        mCandidatesValid = false;
+    }
+    mTangledBodies.assign(mBodies.size(), 0);
+}
+
+void SelfCollision::updateTangled() {
+    if (mHairSegments.empty())
+        for (const auto& e : mEdges)
+            if (!mBodyHasTriangles[mVertexBody[e[0]]]) mHairSegments.push_back(e);
+    // Hair segments through cloth triangles at the pass's start (mTris are the cloth's: hair
+    // has none).
+    const auto through = contact::crossingSegments(mX0, mHairSegments, mX0, mTris);
+    std::vector<uint8_t> tangled;
+    mTangledBodies.assign(mBodies.size(), 0);
+    if (!through.empty()) {
+        tangled.assign(mVertexBody.size(), 0);
+        for (const auto& [seg, tri] : through)
+            for (int v : mHairSegments[static_cast<size_t>(seg)]) {
+                tangled[static_cast<size_t>(v)] = 1;
+                mTangledBodies[static_cast<size_t>(mVertexBody[v])] = 1;
+            }
+    }
+    if (tangled != mTangled) mCandidatesValid = false; // the candidates' filter changed
+    mTangled = std::move(tangled);
+    mStats.tangledHairVertices = 0;
+    for (uint8_t t : mTangled) mStats.tangledHairVertices += t;
+    if (through.empty()) mUntangleHair = false; // clear: the pairs are as for any hair
+}
+
 SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {
     mStats = SelfCollisionStats();
     mX0.resize(3 * mVertexBody.size());
     for (size_t b = 0; b < mBodies.size(); ++b)
         std::copy(start[b].data(), start[b].data() + start[b].size(),
                   mX0.begin() + 3 * mBodies[b].offset);
+    if (mUntangleHair) updateTangled();
     gather();
     mLastHits.clear();
     mPassVt.clear();

@@ -27,6 +27,8 @@ struct SelfCollisionStats {
     long long zoneVertices = 0;   // vertices moved rigidly by impact zones, summed
     long long frozenVertices = 0; // vertices held at x₀ by the last resort
     long long unresolved = 0;     // hits left after every stage (a guarantee breach; reported)
+    // Hair vertices let through cloth (setUntangleHair), the most at one pass's start.
+    long long tangledHairVertices = 0;
     long long halvings = 0;       // substeps the World halved because a pass stretched cloth
     long long retries = 0;        // intervals solved again with the pass's pairs held (World)
     // Pairs skipped because they start touching or crossing (the most in one pass).
@@ -94,6 +96,17 @@ public:
     // each other at rest, searched up to `radius`; +inf when none is that close.
     double minimumSeparation(double radius) const;
 
+    // Hair that starts through cloth, let through (untangling): at each pass's start, the hair
+    // vertices at either end of a segment that crosses a cloth triangle take no part in pairs
+    // with the cloth for that pass, so the strand slides out through the cloth instead of being
+    // held where it crosses (Baraff, Witkin & Kass 2003 let intersecting regions pass the same
+    // way). The crossing moves along the strand and leaves it; the first pass that finds no
+    // crossing turns this off. tangledBodies(): per body, whether a segment of it crossed at the
+    // last pass's start.
+    void setUntangleHair(bool on);
+    bool untanglingHair() const { return mUntangleHair; }
+    const std::vector<uint8_t>& tangledBodies() const { return mTangledBodies; }
+
     // A pair of primitives as four global vertices and signed weights α: the pair's relative
     // position is Σ α_k x_k (vertex − triangle point, or point on one edge − point on the other).
     struct Pair {
@@ -122,6 +135,7 @@ private:
     // Vertex vi against triangle t, and edge e against edge f, as candidates when their boxes
     // overlap: false for primitives sharing a vertex, for four held vertices (nothing can move),
     // and for strand against strand (hair has no triangles: not modelled).
+    // (And false for a hair vertex let through the cloth: mTangled.)
     bool candidateVertexTriangle(int vi, int t) const;
     bool candidateEdgeEdge(int e, int f) const;
     // The candidates again after the vertices marked in `moved` (and only they) moved beyond
@@ -194,6 +208,12 @@ private:
     FlatPatches mFlat;
     std::vector<double> mCertX0, mCertX1;
     std::vector<uint8_t> mInPatch;
+    // Untangling (setUntangleHair): on; per global vertex, let through the cloth this pass;
+    // per body, a segment crossed; the hair segments (global vertices).
+    bool mUntangleHair = false;
+    std::vector<uint8_t> mTangled, mTangledBodies;
+    std::vector<std::array<int, 2>> mHairSegments;
+    void updateTangled(); // at a pass's start (mX0)
     bool mBuilt = false; // the trees (built once, over the rest shape)
     double mMaxThickness = 0.0;
     SelfCollisionStats mStats; // of the pass under way

@@ -107,6 +107,7 @@ void SelfCollision::gatherCandidates(std::vector<Candidate>& vtOut,
 bool SelfCollision::candidateVertexTriangle(int vi, int t) const {
     const auto& tri = mTris[t];
     if (tri[0] == vi || tri[1] == vi || tri[2] == vi) return false;
+    if (!mTangled.empty() && mTangled[vi]) return false;
     return !(mInvMass[vi] == 0.0 && mInvMass[tri[0]] == 0.0 && mInvMass[tri[1]] == 0.0 &&
              mInvMass[tri[2]] == 0.0);
 }
@@ -115,6 +116,9 @@ bool SelfCollision::candidateEdgeEdge(int e, int f) const {
     const auto& ea = mEdges[e];
     const auto& eb = mEdges[f];
     if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) return false;
+    if (!mTangled.empty() &&
+        (mTangled[ea[0]] || mTangled[ea[1]] || mTangled[eb[0]] || mTangled[eb[1]]))
+        return false;
     if (mInvMass[ea[0]] == 0.0 && mInvMass[ea[1]] == 0.0 && mInvMass[eb[0]] == 0.0 &&
         mInvMass[eb[1]] == 0.0)
         return false;

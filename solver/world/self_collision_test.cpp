@@ -546,6 +546,77 @@ TEST_CASE("self-collision: hair that starts through cloth is reported", "[solver
     CHECK(started(firstEvents(0)).empty());
 }
 
+// Strands that start through a pinned plate fall through it when let through where they cross
+// (World::untangleHair): at the end none crosses it, all are below it, and none was stretched on
+// the way; held where they cross instead (the control), they hang from the plate, crossing it.
+TEST_CASE("self-collision: hair that starts through cloth is let through until clear",
+          "[solver][self]") {
+    struct Result {
+        size_t crossings = 0;  // segments through the plate at the end
+        bool allBelow = true;  // every strand vertex below the plate at the end
+        double stretch = 0.0;  // the strands' largest segment stretch, any frame
+        long long tangled = 0; // hair vertices let through, the most at a pass's start
+    };
+    const auto run = [](bool untangle) {
+        WorldSettings ws;
+        ws.untangleHair = untangle;
+        World w(ws);
+        auto plate = std::make_unique<Cloth>(
+            "plate",
+            makeGrid(0.6, 0.6, 13, 13, Vec3(-0.3, 1.0, -0.3), Vec3::UnitX(), Vec3::UnitZ()),
+            ClothMaterial{});
+        PinSet pins;
+        for (int v = 0; v < 13 * 13; ++v) pins.vertices.push_back(v);
+        plate->addPins(pins);
+        plate->collision().self = true;
+        Strands s;
+        s.offsets.clear();
+        for (int k = 0; k < 5; ++k) {
+            s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+            const double x = -0.3 + 0.05 * (2 * k + 1) + 0.013, z = -0.3 + 0.05 * 5 + 0.031;
+            for (int i = 0; i <= 10; ++i)
+                s.positions.insert(s.positions.end(), {x, 1.21 - 0.04 * i, z});
+        }
+        s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+        HairMaterial hm;
+        hm.rootPinned = false;
+        auto hair = std::make_unique<Hair>("plume", s, hm);
+        hair->collision().self = true;
+        const Body* cloth = plate.get();
+        const Body* strands = hair.get();
+        w.addBody(std::move(plate));
+        w.addBody(std::move(hair));
+        Result r;
+        for (int f = 2; f <= 25; ++f) {
+            const FrameStats fs = w.advanceFrame(f);
+            REQUIRE_FALSE(fs.failed);
+            r.stretch = std::max(r.stretch, strands->maxEdgeStretch());
+            r.tangled = std::max(r.tangled, fs.selfContacts.tangledHairVertices);
+        }
+        const VecX& x = strands->positions();
+        const VecX& c = cloth->positions();
+        for (const auto& e : strands->edges())
+            for (const auto& t : *cloth->collisionTriangles())
+                r.crossings += contact::segmentCrossesTriangle(
+                    vec3At(x.data(), e[0]), vec3At(x.data(), e[1]), vec3At(c.data(), t[0]),
+                    vec3At(c.data(), t[1]), vec3At(c.data(), t[2]));
+        for (size_t i = 0; i < strands->vertexCount(); ++i)
+            r.allBelow = r.allBelow && x[3 * i + 1] < 1.0;
+        return r;
+    };
+    const Result let = run(true), held = run(false);
+    INFO("let through: crossings " << let.crossings << ", below " << let.allBelow << ", stretch "
+                                   << let.stretch << ", tangled " << let.tangled);
+    INFO("held: crossings " << held.crossings << ", below " << held.allBelow << ", stretch "
+                            << held.stretch);
+    CHECK(let.tangled > 0);
+    CHECK(let.crossings == 0);
+    CHECK(let.allBelow);
+    CHECK(let.stretch < 1.1);
+    CHECK(held.crossings > 0); // the control: held where they cross, they stay through the plate
+    CHECK_FALSE(held.allBelow);
+}
+
 TEST_CASE("self-collision: hair as heavy as the cloth is left to the pass", "[solver][self]") {
     const PlumeRun light = plumeOnHammock(true, 2);
     const PlumeRun heavy = plumeOnHammock(true, 2, 2e-3);

@@ -127,7 +127,7 @@ void World::setUpSelfCollision(FrameStats& fs) {
     }
     // A start that already intersects cannot be untangled; the passes keep it from worsening.
     const std::vector<int> start = mSelf->intersectionsPerBody();
-    char buf[256];
+    char buf[512];
     for (size_t k = 0; k < mSelfBodies.size(); ++k) {
         if (start[k] == 0) continue;
         std::snprintf(buf, sizeof buf,
@@ -137,9 +137,11 @@ void World::setUpSelfCollision(FrameStats& fs) {
                       start[k]);
         fs.bodies[mSelfBodies[k]].events.push_back(buf);
     }
-    // A hair that starts through a cloth (segments crossing its triangles): the same, and its
-    // contact with that cloth then holds each such segment where it crosses, which can stretch
-    // the hair as the cloth moves away (the hard scenes' hair at 70×: docs/solver.md).
+    // A hair that starts through a cloth (segments crossing its triangles): reported, and let
+    // through the cloth where it crosses until it is clear (SelfCollision::setUntangleHair):
+    // contact would hold each such segment where it crosses, and a cloth moving away then drags
+    // the strand (the hard scenes' hair at 17-70×: docs/solver.md).
+    mHairTangled.assign(mSelfBodies.size() - mClothBodies, 0);
     for (size_t h = mClothBodies; h < mSelfBodies.size(); ++h) {
         const Body& hair = *mBodies[mSelfBodies[h]];
         const std::vector<double> x(hair.positions().data(),
@@ -151,6 +153,10 @@ void World::setUpSelfCollision(FrameStats& fs) {
             const auto through =
                 contact::crossingSegments(x, hair.edges(), y, *cloth.collisionTriangles());
             if (through.empty()) continue;
+            if (mSettings.untangleHair) {
+                mHairTangled[h - mClothBodies] = 1;
+                mSelf->setUntangleHair(true);
+            }
             std::vector<uint8_t> seen(hair.edges().size(), 0);
             int segments = 0;
             for (const auto& [seg, tri] : through) segments += !seen[seg]++;
@@ -159,8 +165,9 @@ void World::setUpSelfCollision(FrameStats& fs) {
                                    vec3At(hair.positions().data(), static_cast<size_t>(b)));
             std::snprintf(buf, sizeof buf,
                           "hair-cloth collision: the start shape has %d segment(s) through cloth "
-                          "'%s' (the first, %d-%d, at (%.4g, %.4g, %.4g)); contact holds each "
-                          "where it crosses (start the hair clear of the cloth)",
+                          "'%s' (the first, %d-%d, at (%.4g, %.4g, %.4g)); the strands are let "
+                          "through the cloth there until they are clear of it (start the hair "
+                          "clear of the cloth to keep it on its side)",
                           segments, cloth.name().c_str(), a, b, at.x(), at.y(), at.z());
             fs.bodies[mSelfBodies[h]].events.push_back(buf);
         }
@@ -217,8 +224,13 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
+        const bool untangling = mSelf->untanglingHair();
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
+        // The hair still through cloth at this interval's start keeps its solve off that cloth.
+        if (untangling)
+            for (size_t h = 0; h < mHairTangled.size(); ++h)
+                mHairTangled[h] = mSelf->tangledBodies()[mClothBodies + h];
         bool stretched = false;
         double worst = 0.0;
         for (size_t k = 0; k < n; ++k) {
@@ -304,6 +316,7 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
 
 const std::vector<Collider>* World::hairColliders(size_t k) const {
     if (k < mClothBodies || k - mClothBodies >= mHairColliders.size()) return nullptr;
+    if (k - mClothBodies < mHairTangled.size() && mHairTangled[k - mClothBodies]) return nullptr;
     const std::vector<Collider>& list = mHairColliders[k - mClothBodies];
     return list.empty() ? nullptr : &list;
 }
