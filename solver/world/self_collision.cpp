@@ -625,7 +625,6 @@ void SelfCollision::updateTangled() {
     mTangled = std::move(tangled);
     mStats.tangledHairVertices = 0;
     for (uint8_t t : mTangled) mStats.tangledHairVertices += t;
-    if (through.empty()) mUntangleHair = false; // clear: the pairs are as for any hair
 }
 
 SelfCollisionStats SelfCollision::resolve(const std::vector<VecX>& start) {

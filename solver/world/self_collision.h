@@ -96,13 +96,13 @@ public:
     // each other at rest, searched up to `radius`; +inf when none is that close.
     double minimumSeparation(double radius) const;
 
-    // Hair that starts through cloth, let through (untangling): at each pass's start, the hair
-    // vertices at either end of a segment that crosses a cloth triangle take no part in pairs
-    // with the cloth for that pass, so the strand slides out through the cloth instead of being
-    // held where it crosses (Baraff, Witkin & Kass 2003 let intersecting regions pass the same
-    // way). The crossing moves along the strand and leaves it; the first pass that finds no
-    // crossing turns this off. tangledBodies(): per body, whether a segment of it crossed at the
-    // last pass's start.
+    // Hair through cloth, let through (untangling): at each pass's start, the hair vertices at
+    // either end of a segment that crosses a cloth triangle take no part in pairs with the
+    // cloth for that pass, so the strand slides out through the cloth instead of being held
+    // where it crosses (Baraff, Witkin & Kass 2003 let intersecting regions pass the same way).
+    // The crossing moves along the strand and leaves it. Without crossings the pass is what it
+    // is without this (the search costs a tree over the cloth's triangles a pass).
+    // tangledBodies(): per body, whether a segment of it crossed at the last pass's start.
     void setUntangleHair(bool on);
     bool untanglingHair() const { return mUntangleHair; }
     const std::vector<uint8_t>& tangledBodies() const { return mTangledBodies; }

@@ -140,8 +140,11 @@ void World::setUpSelfCollision(FrameStats& fs) {
     // A hair that starts through a cloth (segments crossing its triangles): reported, and let
     // through the cloth where it crosses until it is clear (SelfCollision::setUntangleHair):
     // contact would hold each such segment where it crosses, and a cloth moving away then drags
-    // the strand (the hard scenes' hair at 17-70×: docs/solver.md).
+    // the strand (the hard scenes' hair at 6-70×: docs/solver.md).
     mHairTangled.assign(mSelfBodies.size() - mClothBodies, 0);
+    // Every pass looks for hair through cloth, not only after such a start: a strand that starts
+    // touching a cloth (no side to keep) can end a step through it, and is then let through too.
+    if (mSettings.untangleHair && !mHairTangled.empty()) mSelf->setUntangleHair(true);
     for (size_t h = mClothBodies; h < mSelfBodies.size(); ++h) {
         const Body& hair = *mBodies[mSelfBodies[h]];
         const std::vector<double> x(hair.positions().data(),
@@ -153,10 +156,7 @@ void World::setUpSelfCollision(FrameStats& fs) {
             const auto through =
                 contact::crossingSegments(x, hair.edges(), y, *cloth.collisionTriangles());
             if (through.empty()) continue;
-            if (mSettings.untangleHair) {
-                mHairTangled[h - mClothBodies] = 1;
-                mSelf->setUntangleHair(true);
-            }
+            if (mSettings.untangleHair) mHairTangled[h - mClothBodies] = 1;
             std::vector<uint8_t> seen(hair.edges().size(), 0);
             int segments = 0;
             for (const auto& [seg, tri] : through) segments += !seen[seg]++;
@@ -224,11 +224,10 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
-        const bool untangling = mSelf->untanglingHair();
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
-        // The hair still through cloth at this interval's start keeps its solve off that cloth.
-        if (untangling)
+        // A hair through cloth at this interval's start keeps its solve off the cloth.
+        if (mSelf->untanglingHair())
             for (size_t h = 0; h < mHairTangled.size(); ++h)
                 mHairTangled[h] = mSelf->tangledBodies()[mClothBodies + h];
         bool stretched = false;

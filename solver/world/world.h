@@ -48,8 +48,9 @@ struct WorldSettings {
     // over the interval as a moving mesh collider, World::clothAsColliders), not only in the
     // self-collision pass after it. Off: the pass alone (measured against it).
     bool hairMeetsClothInSolve = true;
-    // Hair that starts through a cloth is let through it where it crosses until it is clear
-    // (SelfCollision::setUntangleHair). Off: contact holds it where it crosses (the control).
+    // Hair through a cloth (a start like that, or a strand that started touching it) is let
+    // through where it crosses until it is clear (SelfCollision::setUntangleHair). Off: contact
+    // holds it where it crosses (the control).
     bool untangleHair = true;
     // Cloth resting on cloth is held in its own solve too: the self-collision pass's resting
     // vertex–triangle pairs become sliding contact planes of the next interval's solves
@@ -190,9 +191,9 @@ private:
     size_t mClothBodies = 0;
     std::vector<std::shared_ptr<MovingMeshContact>> mClothContacts;
     std::vector<std::vector<Collider>> mHairColliders;
-    // Per hair (mSelfBodies after the cloth): a segment crossed a cloth at the last pass's start
-    // (SelfCollision::setUntangleHair). Its solve then meets the scene's colliders only, so
-    // that it does not hold the strand where it crosses either.
+    // Per hair (mSelfBodies after the cloth): a segment crossed a cloth at the start, or at the
+    // last pass's (SelfCollision::setUntangleHair). Its solve then meets the scene's colliders
+    // only, so that it does not hold the strand where it crosses either.
     std::vector<uint8_t> mHairTangled;
     // Per colliding body (mSelfBodies), the cloth contact planes of the last accepted pass.
     std::vector<std::vector<ClothContactPlane>> mClothPlanes;
