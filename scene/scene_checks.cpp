@@ -73,6 +73,28 @@ Box colliderBox(const solver::Collider& c, double t0) {
     return b;
 }
 
+// Motion keyed with interp = "step" teleports what it moves: the largest jump between
+// consecutive keys of position `p` (m) whose time falls within the run (t0, t1], and that key's
+// time (s). 0 for anything not step-keyed.
+double stepJump(const fields::Param& p, double t0, double t1, double& at) {
+    double worst = 0.0;
+    if (!p.isKeyed() || p.interp() != fields::KeyInterp::Step || p.width() != 3) return worst;
+    for (size_t k = 1; k < p.times().size(); ++k) {
+        if (!(p.times()[k] > t0 && p.times()[k] <= t1)) continue;
+        const auto& a = p.values()[k - 1];
+        const auto& b = p.values()[k];
+        const double d = Vec3(b[0] - a[0], b[1] - a[1], b[2] - a[2]).norm();
+        if (d > worst) {
+            worst = d;
+            at = p.times()[k];
+        }
+    }
+    return worst;
+}
+
+// A jump of held or colliding geometry worth a warning (m): beyond a cloth's thickness.
+constexpr double kTeleport = 0.01;
+
 } // namespace
 
 std::vector<SceneError> runWarnings(const SimScene& scene,
@@ -146,6 +168,49 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                 "closer to the surface, where the body deforms less, or soften it with stiffness");
         e.warning = true;
         out.push_back(std::move(e));
+    }
+    // Step keys on motion: pins' translation and a sphere's or capsule's position jump within
+    // one substep, at a speed no cloth can follow (it stretches, then snaps back; the hard
+    // scenes' worst energies, bench/README.md).
+    const double t0 = s.frameTime(first), t1 = s.frameTime(last);
+    const double h = 1.0 / (s.fps * std::max(1, s.substeps));
+    const auto teleport = [&](const std::string& what, const char* key, double jump, double at) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      "%s is keyed with interp = \"step\": at t = %.4g s it "
+                      "jumps %s m in one substep (%s m/s)",
+                      key, at, metres(jump).c_str(), metres(jump / h).c_str());
+        return what + ": " + buf +
+               ", a teleport no cloth or hair follows (it stretches, or is pushed through, "
+               "then snaps back); use interp = \"linear\" or \"smooth\", or key the move over "
+               "several frames";
+    };
+    const auto pinsTeleport = [&](const std::string& what, const PinSpec& pins) {
+        double at = 0.0;
+        const double jump = stepJump(pins.translate, t0, t1, at);
+        if (!(jump > kTeleport)) return;
+        SceneError e = sceneErrorAt(scene.wind.path, pins.line, pins.col,
+                                    teleport(what, "translate", jump, at));
+        e.warning = true;
+        out.push_back(std::move(e));
+    };
+    for (const ClothSpec& spec : scene.cloths)
+        if (spec.hasPins) pinsTeleport("[[cloth]] '" + spec.name + "' pins", spec.pins);
+    for (const solver::Collider& c : scene.colliders) {
+        if (c.shape != solver::ColliderShape::Sphere && c.shape != solver::ColliderShape::Capsule)
+            continue;
+        double at = 0.0, atB = 0.0;
+        const double jumpA = stepJump(c.a, t0, t1, at);
+        const double jumpB =
+            c.shape == solver::ColliderShape::Capsule ? stepJump(c.b, t0, t1, atB) : 0.0;
+        const bool isA = jumpA >= jumpB;
+        const double jump = std::max(jumpA, jumpB);
+        if (jump > kTeleport)
+            warn(c, teleport("[[collider]] '" + c.name + "'",
+                             c.shape == solver::ColliderShape::Sphere ? "center"
+                             : isA                                    ? "a"
+                                                                      : "b",
+                             jump, isA ? at : atB));
     }
     for (const solver::Collider& c : scene.colliders) {
         const std::string what = "[[collider]] '" + c.name + "'";

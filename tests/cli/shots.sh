@@ -132,6 +132,17 @@ write_scene far/scene.toml 0 11 0 'cache/body.####.obj'
 run "$GALE" sim far/scene.toml -o far/out
 expect_rc 0 "a far collider does not stop a run"
 expect_match "$ERR" "scene.toml:16:1: warning: .*'box' never comes within [0-9.]+ m of any cloth" "a collider far from the cloth ($ERR)"
+# Step keys on pins teleport the held vertices: a warning at the pins' line with the jump (0.3 m
+# at t = 0.25 s, one substep of 1/48 s: 14.4 m/s); the same keys linear, or a step after the
+# run's end (t = 0.6 s > 11/24 s), say nothing.
+STEP='cloth.sheet.pins.translate={ keys = [[0, [0, 0, 0]], [0.25, [0.3, 0, 0]]], interp = "step" }'
+run "$GALE" check renumbered/scene.toml --set "$STEP"
+expect_rc 0 "a pin teleport still checks"
+expect_match "$ERR" "scene.toml:14:8: warning: \[\[cloth\]\] 'sheet' pins: translate is keyed with interp = \"step\": at t = 0.25 s it jumps 0.3 m in one substep \(14.4 m/s\)" "a pin teleport ($ERR)"
+run "$GALE" check renumbered/scene.toml --set "${STEP/step/linear}"
+expect_no_match "$ERR" "teleport" "linear pin keys ($ERR)"
+run "$GALE" check renumbered/scene.toml --set "${STEP/0.25,/0.6,}"
+expect_no_match "$ERR" "teleport" "a step after the run's end ($ERR)"
 
 # gale check builds the bodies too: what `gale sim` rejects, check rejects, at the same place.
 cat > bad_body.toml <<'EOF'
