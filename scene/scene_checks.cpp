@@ -196,6 +196,50 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     };
     for (const ClothSpec& spec : scene.cloths)
         if (spec.hasPins) pinsTeleport("[[cloth]] '" + spec.name + "' pins", spec.pins);
+    // Pins that carry vertices inside a collider (a plane, sphere, capsule or static mesh: the
+    // shapes with an inside) at some frame of the run: the cloth there can neither leave the
+    // collider nor stay on the pins, and stretches between them (frame trouble "inside a
+    // collider ... and the pin holding vertex N inside it", found here before the run).
+    for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
+        const ClothSpec& spec = scene.cloths[i];
+        const solver::Body& body = *bodies[i];
+        if (!spec.hasPins) continue;
+        for (const solver::Collider& c : scene.colliders) {
+            if (c.moving) continue;
+            int worstFrame = first, worstVertex = -1, frames = 0;
+            double worst = 0.0;
+            for (int f = first; f <= last; ++f) {
+                const double t = s.frameTime(f);
+                const solver::ColliderPose pose = solver::colliderPose(c, t);
+                bool inside = false;
+                for (size_t k = 0; k < body.pinnedVertices().size(); ++k) {
+                    if (body.pinIsAttachment(k)) continue;
+                    const double depth =
+                        -solver::queryCollider(pose, body.pinTarget(k, t)).distance;
+                    if (!(depth > kTeleport)) continue;
+                    inside = true;
+                    if (depth > worst) {
+                        worst = depth;
+                        worstFrame = f;
+                        worstVertex = body.pinnedVertices()[k];
+                    }
+                }
+                frames += inside;
+            }
+            if (worstVertex < 0) continue;
+            SceneError e = sceneErrorAt(
+                scene.wind.path, spec.pins.line, spec.pins.col,
+                "[[cloth]] '" + spec.name + "' pins: they hold vertices inside [[collider]] '" +
+                    c.name + "' in " + std::to_string(frames) + " frame(s) of the run (vertex " +
+                    std::to_string(worstVertex) + " " + metres(worst) +
+                    " m below its surface at frame " + std::to_string(worstFrame) +
+                    "): the cloth there can neither leave the collider nor stay on the pins, and "
+                    "stretches between them; move the pins (or their translate keys) or the "
+                    "collider");
+            e.warning = true;
+            out.push_back(std::move(e));
+        }
+    }
     for (const solver::Collider& c : scene.colliders) {
         if (c.shape != solver::ColliderShape::Sphere && c.shape != solver::ColliderShape::Capsule)
             continue;

@@ -143,6 +143,29 @@ run "$GALE" check renumbered/scene.toml --set "${STEP/step/linear}"
 expect_no_match "$ERR" "teleport" "linear pin keys ($ERR)"
 run "$GALE" check renumbered/scene.toml --set "${STEP/0.25,/0.6,}"
 expect_no_match "$ERR" "teleport" "a step after the run's end ($ERR)"
+# Pins keyed down through the floor hold their vertices inside it: a warning at the pins' line
+# (the pinned row, at 0.6 m, keyed 0.85 m down by t = 0.5 s: 0.25 m below the floor); the same
+# pins left where they are say nothing.
+cat > pinned_floor.toml <<'EOF'
+[scene]
+frames = [1, 13]
+
+[[cloth]]
+name = "sheet"
+grid = { size = [0.6, 0.6], res = [8, 8], origin = [-0.3, 0.6, -0.3], axes = "xz" }
+pins = { box = [-0.31, 0.59, -0.31, 0.31, 0.61, -0.29], translate = { keys = [[0, [0, 0, 0]], [0.5, [0, -0.85, 0]]] } }
+
+[[collider]]
+name = "floor"
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+EOF
+run "$GALE" check pinned_floor.toml
+expect_rc 0 "pins through the floor still check"
+expect_match "$ERR" "pinned_floor.toml:7:8: warning: .*'sheet' pins: they hold vertices inside .*'floor' in [0-9]+ frame.s. of the run .vertex [0-9]+ 0.25 m below its surface at frame [0-9]+" "pins inside the floor ($ERR)"
+run "$GALE" check pinned_floor.toml --set 'cloth.sheet.pins.translate=[0, 0, 0]'
+expect_no_match "$ERR" "inside" "pins above the floor ($ERR)"
 
 # gale check builds the bodies too: what `gale sim` rejects, check rejects, at the same place.
 cat > bad_body.toml <<'EOF'
