@@ -121,6 +121,7 @@ public:
     py::dict settings() const {
         return py::module_::import("json").attr("loads")(mSim->settings());
     }
+    std::vector<std::string> warnings() const { return mSim->warnings(); }
     int first() const { return mSim->first(); }
     int last() const { return mSim->last(); }
 
@@ -269,6 +270,9 @@ void addScene(py::module_& m) {
         .def("__next__", &Simulation::next)
         .def_property_readonly("settings", &Simulation::settings,
                                "run.json's settings: the scene as resolved")
+        .def_property_readonly("warnings", &Simulation::warnings,
+                               "run.json's warnings: likely mistakes in the scene, "
+                               "'file:line:col: message' each")
         .def_property_readonly(
             "frames", [](const Simulation& s) { return py::make_tuple(s.first(), s.last()); });
     py::class_<Scene>(m, "Scene",

@@ -227,7 +227,10 @@ RunError SimOutput::writeObjects(int frame, double time) {
 
 RunError SimOutput::writeRun(const std::string& status, std::string* text) {
     std::string run =
-        "{\"status\": \"" + status + "\", \"settings\": " + mRun->settings() + ", \"frames\": [";
+        "{\"status\": \"" + status + "\", \"settings\": " + mRun->settings() + ", \"warnings\": [";
+    for (size_t i = 0; i < mRun->warnings().size(); ++i)
+        run += (i ? ", " : "") + io::jsonString(mRun->warnings()[i]);
+    run += "], \"frames\": [";
     for (size_t i = 0; i < mFrames.size(); ++i) run += (i ? ",\n  " : "\n  ") + mFrames[i];
     run += "\n]}\n";
     RunError e = writeBytes(mRunPath, run);

@@ -118,7 +118,11 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     if (!scene::prerollSequences(mScene, shotStart, errors)) return sceneErrors(errors);
     if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths, mRunUpFrom))
         return sceneErrors(errors);
-    for (const std::string& w : warnings) report += "gale: warning: " + w + '\n';
+    mWarnings.clear();
+    for (const std::string& w : warnings) {
+        report += "gale: warning: " + w + '\n';
+        mWarnings.push_back(w);
+    }
     if (bodies.empty()) {
         err.kind = RunError::Input;
         err.message = s.scene + ": the scene has no [[cloth]] or [[hair]] to simulate";
@@ -126,8 +130,14 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     }
     mSettings = settingsJson(mScene, bodies, mFirst, mLast, s.threads, s.sets);
     mInputs = digestInputs(mScene, s.sets);
-    for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast))
+    for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast)) {
         report += w.render() + '\n';
+        // As the bodies' warnings: "file:line:col: message", without the source line.
+        mWarnings.push_back(w.file +
+                            (w.line > 0 ? ":" + std::to_string(w.line) + ":" + std::to_string(w.col)
+                                        : std::string()) +
+                            ": " + w.message);
+    }
 
     mWorld = std::make_unique<solver::World>(scene::worldSettings(mScene, s.threads));
     mWorld->setWind(wind);

@@ -49,6 +49,9 @@ public:
     double fps() const { return mScene.wind.settings.fps; }
     // run.json's "settings": the scene as resolved, for this frame range and thread count.
     const std::string& settings() const { return mSettings; }
+    // The warnings load() reported (building the bodies, scene_checks.h), one line each as
+    // "file:line:col: message" (run.json's "warnings").
+    const std::vector<std::string>& warnings() const { return mWarnings; }
     // A digest of what the run reads besides its settings — the scene file's text, the --set
     // overrides, the expression files (their bytes), meshes, strands and attachment sequences
     // (their sizes and times) — so that --resume refuses a run whose inputs changed since.
@@ -78,6 +81,7 @@ private:
     int mFirst = 0, mLast = 0;
     int mRunUpFrom = 0; // the frame the run-up starts at (its initial state)
     std::string mSettings;
+    std::vector<std::string> mWarnings;
     std::string mInputs;
 };
 

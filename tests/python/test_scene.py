@@ -56,6 +56,20 @@ def test_simulate_equals_gale_sim(src, tmp_path, gale_bin):
     assert next(iter(sim), None) is None
 
 
+def test_warnings_as_in_run_json(src, tmp_path, gale_bin):
+    # Lift above drag is a likely mistake: gale sim warns and writes it to run.json's warnings,
+    # and the Python simulation has the same list; the scene as shipped has none.
+    scene = src / "examples" / "03_cape" / "scene.toml"
+    out = tmp_path / "sim"
+    run_gale(gale_bin, "sim", scene, "-o", out, "--frames", "1:2", "--set", "cloth.cape.lift=1.5")
+    run = json.loads((out / "run.json").read_text())
+    sim = gale.Scene(str(scene), set={"cloth.cape.lift": 1.5}).simulate(frames=(1, 2))
+    assert len(run["warnings"]) == 1 and "exceeds drag" in run["warnings"][0]
+    assert run["warnings"][0].startswith(str(scene) + ":")
+    assert sim.warnings == run["warnings"]
+    assert gale.Scene(str(scene)).simulate(frames=(1, 2)).warnings == []
+
+
 def test_a_late_range_starts_from_the_simulated_state(src):
     # Frames 6..9 on their own are the frames 6..9 of the run from the scene's first frame: the
     # frames before the range are simulated first (never the rest mesh at frame 6).
