@@ -3,8 +3,9 @@
 one line per scene, worst first, and a summary. A frame's over-stretch beyond the limit carries
 what forced it (`forced_by`; `scene`: true when pins, attachments or colliders force it, false
 when the solver left it) and whether the scene starts intersecting (`start`: a cloth through
-itself or another, a hair through a cloth, as the run's first-frame events say). Reported, not
-asserted.
+itself or another, a hair through a cloth, as the run's first-frame events say), and what the
+run warned of at load that forces stretch (step keys that teleport pins or colliders, pins inside
+a collider: run.json's warnings). Reported, not asserted.
 
     hard_scenes_report.py OUT_FOLDER [--top N]"""
 import glob
@@ -31,6 +32,14 @@ def scene_stats(run_json):
                          "forced_by": forced, "scene": scene}
             energy = max(energy, (o.get("energy") or {}).get("total", 0.0) or 0.0)
     worst["start"] = tangled
+    # What the run warned of at load that forces stretch (run.json's warnings).
+    warned = []
+    for w in r.get("warnings", []):
+        if "teleport" in w:
+            warned.append("step keys teleport")
+        elif "hold vertices inside" in w:
+            warned.append("pins inside a collider")
+    worst["warned"] = sorted(set(warned))
     return worst, energy
 
 
@@ -50,17 +59,21 @@ def main(argv):
     print("scene  object  largest stretch (frame)  largest total energy (J)  forced by")
     for s, name, w, e in rows[:top]:
         who = w["forced_by"] or ("(below the over-stretch limit: not attributed)")
-        print("%s  %s  %.3f (%d)  %.4g  %s%s%s" % (name, w["object"], s, w["frame"], e, who,
-                                                  " [scene]" if w["scene"] else "",
-                                                  " [starts intersecting]" if w["start"] else ""))
+        print("%s  %s  %.3f (%d)  %.4g  %s%s%s%s" % (name, w["object"], s, w["frame"], e, who,
+                                                    " [scene]" if w["scene"] else "",
+                                                    " [starts intersecting]" if w["start"] else "",
+                                                    "".join(" [%s]" % x for x in w["warned"])))
     n = len(rows)
     over = lambda x: sum(1 for r in rows if r[0] > x)
     solver = sum(1 for r in rows if r[0] > 1.5 and r[2]["scene"] is False)
     scene = sum(1 for r in rows if r[0] > 1.5 and r[2]["scene"] is True)
     print("summary scenes=%d over_1.2=%d over_1.5=%d over_3=%d over_1.5_forced_by_scene=%d "
-          "over_1.5_by_solver=%d unattributed=%d over_1.5_starting_intersected=%d"
+          "over_1.5_by_solver=%d unattributed=%d over_1.5_starting_intersected=%d "
+          "over_1.5_warned=%d over_3_warned=%d"
           % (n, over(1.2), over(1.5), over(3.0), scene, solver, over(1.5) - scene - solver,
-             sum(1 for r in rows if r[0] > 1.5 and r[2]["start"])))
+             sum(1 for r in rows if r[0] > 1.5 and r[2]["start"]),
+             sum(1 for r in rows if r[0] > 1.5 and r[2]["warned"]),
+             sum(1 for r in rows if r[0] > 3.0 and r[2]["warned"])))
 
 
 if __name__ == "__main__":
