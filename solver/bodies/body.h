@@ -111,6 +111,9 @@ struct StepOptions {
     // than this projects every such edge back to it, by the same projection (Provot 1995's
     // limit, solved as Goldenthal et al. 2007 do; [solver] stretch_limit).
     double stretchLimit = 0.0;
+    // Contacts of vertices stacked behind a deeper edge neighbour along the normal wait a
+    // round (Body::updateContacts). Off: every vertex that ends inside is held at once.
+    bool deferStackedContacts = true;
 };
 
 // What a substep sees of the world.
@@ -428,6 +431,7 @@ private:
     std::vector<uint8_t> mHeld; // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mEdgeRest;
+    std::vector<double> mDeferDepth; // updateContacts: per vertex, its depth past the surface
     BlockMatrix mA;
     FilteredSolver mSolver;
     double mResidualFloor = 0.0; // N·s: the substep's absolute floor of the PCG residual
