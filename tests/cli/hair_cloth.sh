@@ -103,4 +103,22 @@ expect_rc 0 "the plume without cloth collision"
 run check off
 echo "collide_cloth = false: $OUT"
 expect_rc 1 "without collide_cloth the strands fall through ($OUT)"
+
+# Strands that start through the sheet: `gale check` warns at the [[hair]] line, counting the
+# segments that cross it (five vertical strands through five cells, off their diagonals); the
+# plume above it says nothing.
+run "$GALE" check on.toml
+expect_no_match "$ERR" "starts through" "the plume above the sheet ($ERR)"
+"$PY" - <<'PY'
+with open("through.csv", "w") as f:
+    f.write("x,y,z,strand\n")
+    for s in range(5):
+        for k in range(11):
+            f.write("%.6f,%.6f,%.6f,%d\n" % (-0.3 + 0.05 * (2 * s + 1) + 0.013, 1.21 - 0.04 * k,
+                                            -0.3 + 0.05 * 5 + 0.031, s))
+PY
+sed 's/plume.csv/through.csv/' on.toml > through.toml
+run "$GALE" check through.toml
+expect_rc 0 "strands through the sheet still check"
+expect_match "$ERR" "through.toml:12:1: warning: \\[\\[hair\\]\\] 'plume' starts through \\[\\[cloth\\]\\] 'sheet': 5 segment\\(s\\) cross it" "strands through the sheet ($ERR)"
 finish
