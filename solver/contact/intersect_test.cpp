@@ -39,6 +39,17 @@ bool referenceTriangles(const Vec3 t[3], const Vec3 u[3], double& margin) {
     }
     return hit;
 }
+// The triangles of an n × n grid of vertices (row-major), two per cell.
+std::vector<std::array<int, 3>> gridTriangles(int n) {
+    std::vector<std::array<int, 3>> tris;
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const int a = j * n + i;
+            tris.push_back({a, a + 1, a + n});
+            tris.push_back({a + 1, a + n + 1, a + n});
+        }
+    return tris;
+}
 } // namespace
 
 TEST_CASE("intersect: orientation signs", "[contact][intersect]") {
@@ -115,13 +126,7 @@ TEST_CASE("intersect: a crumpled mesh's pairs match brute force", "[contact][int
             x.push_back(j * 0.1 + 0.08 * U(rng));
             x.push_back(0.3 * U(rng));
         }
-    std::vector<std::array<int, 3>> tris;
-    for (int j = 0; j + 1 < n; ++j)
-        for (int i = 0; i + 1 < n; ++i) {
-            const int a = j * n + i;
-            tris.push_back({a, a + 1, a + n});
-            tris.push_back({a + 1, a + n + 1, a + n});
-        }
+    const std::vector<std::array<int, 3>> tris = gridTriangles(n);
     const auto pairs = intersectingPairs(x, tris);
     const auto at = [&](int v) { return Vec3(x[3 * v], x[3 * v + 1], x[3 * v + 2]); };
     std::vector<std::pair<int, int>> want;
@@ -163,13 +168,7 @@ TEST_CASE("intersect: strands through a crumpled sheet match the independent tes
             y.push_back(0.05 * U(rng));
             y.push_back(j * 0.1 + 0.03 * U(rng));
         }
-    std::vector<std::array<int, 3>> tris;
-    for (int j = 0; j + 1 < n; ++j)
-        for (int i = 0; i + 1 < n; ++i) {
-            const int a = j * n + i;
-            tris.push_back({a, a + 1, a + n});
-            tris.push_back({a + 1, a + n + 1, a + n});
-        }
+    const std::vector<std::array<int, 3>> tris = gridTriangles(n);
     std::vector<double> x;
     std::vector<std::array<int, 2>> segs;
     for (int s = 0; s < 40; ++s) {

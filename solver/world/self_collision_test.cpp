@@ -499,38 +499,48 @@ TEST_CASE("self-collision: hair meets cloth in its own solve and not only in the
     }
 }
 
-// Only light hair meets a cloth in its solve (the cloth does not feel it there): 2 mm braids as
-// heavy as the hammock are left to the pass, which shares each correction by inverse mass, so the
-// hammock carries them and sags further than under the light plume.
+namespace {
+
+// A plate (0.6 m, 13 × 13, every vertex pinned) at y = 1 and five vertical strands of 10 segments
+// hanging from y = 1.21, free at the root: the first `through` of them through five cells of the
+// plate (off the cells' diagonals), the others 0.2 m beyond it. Returns the plate and the strands.
+std::pair<const Body*, const Body*> plateAndStrands(World& w, int through) {
+    auto plate = std::make_unique<Cloth>(
+        "plate", makeGrid(0.6, 0.6, 13, 13, Vec3(-0.3, 1.0, -0.3), Vec3::UnitX(), Vec3::UnitZ()),
+        ClothMaterial{});
+    PinSet pins;
+    for (int v = 0; v < 13 * 13; ++v) pins.vertices.push_back(v);
+    plate->addPins(pins);
+    plate->collision().self = true;
+    Strands s;
+    s.offsets.clear();
+    for (int k = 0; k < 5; ++k) {
+        s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+        const double x = k < through ? -0.3 + 0.05 * (2 * k + 1) + 0.013 : 0.5;
+        const double z = -0.3 + 0.05 * 5 + 0.031;
+        for (int i = 0; i <= 10; ++i)
+            s.positions.insert(s.positions.end(), {x, 1.21 - 0.04 * i, z});
+    }
+    s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
+    HairMaterial hm;
+    hm.rootPinned = false;
+    auto hair = std::make_unique<Hair>("plume", s, hm);
+    hair->collision().self = true;
+    const std::pair<const Body*, const Body*> out{plate.get(), hair.get()};
+    w.addBody(std::move(plate));
+    w.addBody(std::move(hair));
+    return out;
+}
+
+} // namespace
+
 // A hair that starts through a cloth is reported at the first frame (as an intersecting cloth
-// start is): three vertical strands through a pinned sheet, two beside it; the event counts the
-// three segments that cross, and a start with all five beside says nothing.
+// start is): three strands through a pinned plate, two beside it; the event counts the three
+// segments that cross, and a start with all five beside says nothing.
 TEST_CASE("self-collision: hair that starts through cloth is reported", "[solver][self]") {
     const auto firstEvents = [](int through) {
         World w(WorldSettings{});
-        auto sheet = std::make_unique<Cloth>(
-            "sheet",
-            makeGrid(0.6, 0.6, 13, 13, Vec3(-0.3, 1.0, -0.3), Vec3::UnitX(), Vec3::UnitZ()),
-            ClothMaterial{});
-        PinSet pins;
-        for (int v = 0; v < 13 * 13; ++v) pins.vertices.push_back(v);
-        sheet->addPins(pins);
-        sheet->collision().self = true;
-        Strands s;
-        s.offsets.clear();
-        for (int k = 0; k < 5; ++k) {
-            s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
-            // Inside a grid cell off its diagonal (cells 0.05 m), or 0.2 m beyond the sheet.
-            const double x = k < through ? -0.3 + 0.05 * (2 * k + 1) + 0.013 : 0.5;
-            const double z = -0.3 + 0.05 * 5 + 0.031;
-            for (int i = 0; i <= 10; ++i)
-                s.positions.insert(s.positions.end(), {x, 1.21 - 0.04 * i, z});
-        }
-        s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
-        auto hair = std::make_unique<Hair>("plume", s, HairMaterial{});
-        hair->collision().self = true;
-        w.addBody(std::move(sheet));
-        w.addBody(std::move(hair));
+        plateAndStrands(w, through);
         const FrameStats fs = w.advanceFrame(2);
         REQUIRE_FALSE(fs.failed);
         return fs.bodies[1].events;
@@ -542,7 +552,7 @@ TEST_CASE("self-collision: hair that starts through cloth is reported", "[solver
     };
     const std::string three = started(firstEvents(3));
     INFO(three);
-    CHECK(three.find("has 3 segment(s) through cloth 'sheet'") != std::string::npos);
+    CHECK(three.find("has 3 segment(s) through cloth 'plate'") != std::string::npos);
     CHECK(started(firstEvents(0)).empty());
 }
 
@@ -561,31 +571,7 @@ TEST_CASE("self-collision: hair that starts through cloth is let through until c
         WorldSettings ws;
         ws.untangleHair = untangle;
         World w(ws);
-        auto plate = std::make_unique<Cloth>(
-            "plate",
-            makeGrid(0.6, 0.6, 13, 13, Vec3(-0.3, 1.0, -0.3), Vec3::UnitX(), Vec3::UnitZ()),
-            ClothMaterial{});
-        PinSet pins;
-        for (int v = 0; v < 13 * 13; ++v) pins.vertices.push_back(v);
-        plate->addPins(pins);
-        plate->collision().self = true;
-        Strands s;
-        s.offsets.clear();
-        for (int k = 0; k < 5; ++k) {
-            s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
-            const double x = -0.3 + 0.05 * (2 * k + 1) + 0.013, z = -0.3 + 0.05 * 5 + 0.031;
-            for (int i = 0; i <= 10; ++i)
-                s.positions.insert(s.positions.end(), {x, 1.21 - 0.04 * i, z});
-        }
-        s.offsets.push_back(static_cast<int>(s.positions.size() / 3));
-        HairMaterial hm;
-        hm.rootPinned = false;
-        auto hair = std::make_unique<Hair>("plume", s, hm);
-        hair->collision().self = true;
-        const Body* cloth = plate.get();
-        const Body* strands = hair.get();
-        w.addBody(std::move(plate));
-        w.addBody(std::move(hair));
+        const auto [cloth, strands] = plateAndStrands(w, 5);
         Result r;
         for (int f = 2; f <= 25; ++f) {
             const FrameStats fs = w.advanceFrame(f);
@@ -617,6 +603,9 @@ TEST_CASE("self-collision: hair that starts through cloth is let through until c
     CHECK_FALSE(held.allBelow);
 }
 
+// Only light hair meets a cloth in its solve (the cloth does not feel it there): 2 mm braids as
+// heavy as the hammock are left to the pass, which shares each correction by inverse mass, so the
+// hammock carries them and sags further than under the light plume.
 TEST_CASE("self-collision: hair as heavy as the cloth is left to the pass", "[solver][self]") {
     const PlumeRun light = plumeOnHammock(true, 2);
     const PlumeRun heavy = plumeOnHammock(true, 2, 2e-3);
