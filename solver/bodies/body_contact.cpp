@@ -392,11 +392,13 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         if (mOptions.deferStackedContacts && !c.moving)
             for (size_t i = 0; i < n; ++i) {
                 if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
-                const Vec3 x1 =
-                    vec3At(x0.data(), i) + h * (vec3At(v0.data(), i) + vec3At(mDv.data(), i));
+                const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
+                const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
                 ContactPoint cp;
+                // The test below: a vertex that would get a contact this round (so that one
+                // waits only behind a neighbour that is held, never round after round).
                 if (endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
-                    cp.distance < thick - kContactSlop)
+                    cp.distance < thick - kContactSlop && (v1 - cp.velocity).dot(cp.normal) < 0.0)
                     mDeferDepth[i] = thick - kContactSlop - cp.distance;
             }
         std::vector<uint8_t> deferred;
