@@ -2,6 +2,8 @@
 // without allocating so that built-in kernels can call them per lane.
 #include "fields/keyframes.h"
 
+#include <cmath>
+
 #include <algorithm>
 
 namespace gale::fields {
@@ -60,6 +62,24 @@ std::vector<double> Param::at(double t) const {
     std::vector<double> out(static_cast<size_t>(width()));
     evaluate(t, out.data());
     return out;
+}
+
+double Param::stepJump(double t0, double t1, double* at) const {
+    double worst = 0.0;
+    if (mInterp != KeyInterp::Step) return worst;
+    for (size_t k = 1; k < mTimes.size(); ++k) {
+        if (!(mTimes[k] > t0 && mTimes[k] <= t1)) continue;
+        double d2 = 0.0;
+        for (size_t c = 0; c < mValues[k].size(); ++c) {
+            const double d = mValues[k][c] - mValues[k - 1][c];
+            d2 += d * d;
+        }
+        if (std::sqrt(d2) > worst) {
+            worst = std::sqrt(d2);
+            if (at) *at = mTimes[k];
+        }
+    }
+    return worst;
 }
 
 double Param::scalarAt(double t) const {

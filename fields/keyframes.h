@@ -27,6 +27,10 @@ public:
     // The same without allocating: writes width() values to `out`.
     void evaluate(double t, double* out) const;
     double scalarAt(double t) const; // component 0 of at(t)
+    // Step keys jump: the largest change between consecutive keys whose time is in (t0, t1]
+    // (the Euclidean norm of the values' difference), and that key's time in *at; 0 for keys
+    // of any other interpolation and for a constant.
+    double stepJump(double t0, double t1, double* at = nullptr) const;
 
     const std::vector<double>& times() const { return mTimes; }
     const std::vector<std::vector<double>>& values() const { return mValues; }

@@ -3,6 +3,7 @@
 
 #include "solver/collider/moving_collider.h"
 #include "solver/contact/intersect.h"
+#include "solver/world/frame_trouble.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +19,8 @@ namespace {
 
 // How far the body may stretch or compress an attached edge before runWarnings says so.
 constexpr double kBindingLimit = 0.10;
+// How deep inside a collider a pin may hold a vertex before runWarnings says so (m).
+constexpr double kPinDepth = 0.01;
 
 struct Box {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
@@ -73,28 +76,6 @@ Box colliderBox(const solver::Collider& c, double t0) {
     }
     return b;
 }
-
-// Motion keyed with interp = "step" teleports what it moves: the largest jump between
-// consecutive keys of position `p` (m) whose time falls within the run (t0, t1], and that key's
-// time (s). 0 for anything not step-keyed.
-double stepJump(const fields::Param& p, double t0, double t1, double& at) {
-    double worst = 0.0;
-    if (!p.isKeyed() || p.interp() != fields::KeyInterp::Step || p.width() != 3) return worst;
-    for (size_t k = 1; k < p.times().size(); ++k) {
-        if (!(p.times()[k] > t0 && p.times()[k] <= t1)) continue;
-        const auto& a = p.values()[k - 1];
-        const auto& b = p.values()[k];
-        const double d = Vec3(b[0] - a[0], b[1] - a[1], b[2] - a[2]).norm();
-        if (d > worst) {
-            worst = d;
-            at = p.times()[k];
-        }
-    }
-    return worst;
-}
-
-// A jump of held or colliding geometry worth a warning (m): beyond a cloth's thickness.
-constexpr double kTeleport = 0.01;
 
 } // namespace
 
@@ -188,8 +169,8 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     };
     const auto pinsTeleport = [&](const std::string& what, const PinSpec& pins) {
         double at = 0.0;
-        const double jump = stepJump(pins.translate, t0, t1, at);
-        if (!(jump > kTeleport)) return;
+        const double jump = pins.translate.stepJump(t0, t1, &at);
+        if (!(jump > solver::kTeleportTolerance)) return;
         SceneError e = sceneErrorAt(scene.wind.path, pins.line, pins.col,
                                     teleport(what, "translate", jump, at));
         e.warning = true;
@@ -217,7 +198,7 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                     if (body.pinIsAttachment(k)) continue;
                     const double depth =
                         -solver::queryCollider(pose, body.pinTarget(k, t)).distance;
-                    if (!(depth > kTeleport)) continue;
+                    if (!(depth > kPinDepth)) continue;
                     inside = true;
                     if (depth > worst) {
                         worst = depth;
@@ -280,12 +261,12 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         if (c.shape != solver::ColliderShape::Sphere && c.shape != solver::ColliderShape::Capsule)
             continue;
         double at = 0.0, atB = 0.0;
-        const double jumpA = stepJump(c.a, t0, t1, at);
+        const double jumpA = c.a.stepJump(t0, t1, &at);
         const double jumpB =
-            c.shape == solver::ColliderShape::Capsule ? stepJump(c.b, t0, t1, atB) : 0.0;
+            c.shape == solver::ColliderShape::Capsule ? c.b.stepJump(t0, t1, &atB) : 0.0;
         const bool isA = jumpA >= jumpB;
         const double jump = std::max(jumpA, jumpB);
-        if (jump > kTeleport)
+        if (jump > solver::kTeleportTolerance)
             warn(c, teleport("[[collider]] '" + c.name + "'",
                              c.shape == solver::ColliderShape::Sphere ? "center"
                              : isA                                    ? "a"

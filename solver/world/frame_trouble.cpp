@@ -48,12 +48,18 @@ std::string FrameTrouble::text() const {
     if (count > 1)
         s += " (" + std::to_string(count) +
              (kind == Kind::OverStretch ? " edges past the limit)" : " vertices inside)");
-    s += ", forced by " + forcedBy + (scene ? " (the scene's: held vertices cannot follow)" : "");
+    // The scene's: held vertices (pulled apart, or held inside), or a collider's teleport alone.
+    const bool held = forcedBy.find("holding") != std::string::npos ||
+                      forcedBy.find("jumped") == std::string::npos;
+    s += ", forced by " + forcedBy +
+         (!scene ? ""
+          : held ? " (the scene's: held vertices cannot follow)"
+                 : " (the scene's: no cloth follows a teleport)");
     return s;
 }
 
 void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, double t,
-                      double overStretch, std::vector<FrameTrouble>& out) {
+                      double overStretch, std::vector<FrameTrouble>& out, double frameStart) {
     const VecX& x = body.positions();
     const std::vector<uint8_t> held = heldBy(body);
     std::vector<ColliderPose> poses;
@@ -75,6 +81,19 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
     auto colliderName = [&](int c) {
         return "collider '" + (colliders[c].name.empty() ? std::to_string(c) : colliders[c].name) +
                "'";
+    };
+    // A collider that jumped in this frame (step keys): what it forces is the scene's, said so.
+    auto jumped = [&](int c, std::string& forcedBy) {
+        double at = 0.0, atB = 0.0;
+        const Collider& k = colliders[static_cast<size_t>(c)];
+        const double a = k.a.stepJump(frameStart, t, &at), b = k.b.stepJump(frameStart, t, &atB);
+        const double jump = std::max(a, b);
+        if (!(jump > kTeleportTolerance)) return false;
+        char buf[96];
+        std::snprintf(buf, sizeof buf, " (it jumped %.3g m at t = %.4g s: step keys)", jump,
+                      a >= b ? at : atB);
+        forcedBy += buf;
+        return true;
     };
 
     // ---- over-stretch: r_e = |x_j − x_i| / L_e > over_stretch ----
@@ -106,6 +125,7 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
             for (int v : {s.vertex, s.other})
                 if (c < 0) c = near(v);
             s.forcedBy = c >= 0 ? colliderName(c) : "the solver";
+            if (c >= 0 && jumped(c, s.forcedBy)) s.scene = true;
         }
         out.push_back(s);
     }
@@ -130,6 +150,7 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
         if (in.count == 0) continue;
         in.position = pos(in.vertex);
         in.forcedBy = colliderName(static_cast<int>(c));
+        if (jumped(static_cast<int>(c), in.forcedBy)) in.scene = true;
         if (heldInside) {
             in.forcedBy += std::string(" and the ") + holder(held[in.vertex]) + " holding vertex " +
                            std::to_string(in.vertex) + " inside it";

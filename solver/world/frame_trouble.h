@@ -6,6 +6,7 @@
 #include "solver/bodies/body.h"
 #include "solver/collider/collider.h"
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,10 +36,17 @@ struct FrameTrouble {
 // solve keeps it `thickness` outside, so this is a miss by thickness + 1 mm.
 constexpr double kInsideTolerance = 1e-3;
 
+// A step-keyed jump of a collider's position larger than this (m, about a cloth's thickness) is
+// a teleport: trouble it forces in that frame is the scene's (and scene checks warn of it).
+constexpr double kTeleportTolerance = 0.01;
+
 // The trouble `body` ends its frame with at time t, appended to `out` (at most one entry per kind
 // and collider). Moving mesh colliders are surfaces without an inside (CCD keeps cloth from
 // crossing them) and are not searched for inside vertices.
+// frameStart: the frame's start time; a collider whose step keys jump more than
+// kTeleportTolerance within (frameStart, t] forces its trouble as the scene's ("jumped ...").
 void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, double t,
-                      double overStretch, std::vector<FrameTrouble>& out);
+                      double overStretch, std::vector<FrameTrouble>& out,
+                      double frameStart = INFINITY);
 
 } // namespace gale::solver

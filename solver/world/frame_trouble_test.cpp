@@ -112,3 +112,29 @@ TEST_CASE("frame trouble: the deepest vertex inside a collider", "[frame_trouble
     CHECK(out[0].scene);
     CHECK(out[0].forcedBy.find("pin holding vertex 0") != std::string::npos);
 }
+
+// A collider whose step keys jump within the frame (a teleport) forces its trouble as the scene's,
+// and says so; looked at over another frame (or with no frame start given), it is the collider's.
+TEST_CASE("frame trouble: a collider that jumped into the cloth is the scene's",
+          "[frame_trouble]") {
+    auto c = strip(false);
+    Collider ball = sphere(Vec3(0.0, -0.19, 0.0), 0.2, "ball"); // vertex 0 is 1 cm inside at t = 1
+    ball.a = Param::keyed({0.0, 0.5}, {{0.0, -2.0, 0.0}, {0.0, -0.19, 0.0}},
+                          gale::fields::KeyInterp::Step);
+    std::vector<FrameTrouble> out;
+    findFrameTrouble(*c, {ball}, 0.5, 3.0, out, 0.5 - 1.0 / 24.0);
+    std::vector<FrameTrouble> inside;
+    for (const FrameTrouble& t : out)
+        if (t.kind == FrameTrouble::Kind::InsideCollider) inside.push_back(t);
+    REQUIRE(inside.size() == 1);
+    INFO(inside[0].text());
+    CHECK(inside[0].scene);
+    CHECK(inside[0].forcedBy.find("jumped 1.81 m at t = 0.5 s") != std::string::npos);
+    CHECK(inside[0].text().find("(the scene's: no cloth follows a teleport)") != std::string::npos);
+    // The next frame: the jump is behind it.
+    out.clear();
+    findFrameTrouble(*c, {ball}, 0.5 + 1.0 / 24.0, 3.0, out, 0.5);
+    REQUIRE_FALSE(out.empty());
+    CHECK_FALSE(out.back().scene);
+    CHECK(out.back().forcedBy == "collider 'ball'");
+}

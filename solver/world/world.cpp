@@ -503,7 +503,8 @@ void World::finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const 
     stats.potential = body.potentialEnergy(mSettings.gravity);
     stats.elastic = body.elasticEnergy(t1);
     if (stats.failed) return;
-    findFrameTrouble(body, mColliders, t1, body.limits().overStretch, stats.trouble);
+    findFrameTrouble(body, mColliders, t1, body.limits().overStretch, stats.trouble,
+                     t1 - 1.0 / mSettings.fps);
     for (const FrameTrouble& tr : stats.trouble) stats.events.push_back("trouble: " + tr.text());
 }
 
