@@ -59,3 +59,20 @@ TEST_CASE("vector keys interpolate every component", "[keyframes]") {
     CHECK(out[2] == 1.5);
     CHECK(p.scalarAt(2) == 0.5);
 }
+
+TEST_CASE("step keys' jumps within a window", "[keyframes]") {
+    // Jumps of 5 (3-4-5) at t = 1 and 13 (5-12-13) at t = 2: the largest in (t0, t1], its time.
+    Param p = Param::keyed({0, 1, 2}, {{0, 0}, {3, 4}, {-2, -8}}, KeyInterp::Step);
+    double at = -1.0;
+    CHECK(p.stepJump(0.0, 3.0, &at) == 13.0);
+    CHECK(at == 2.0);
+    CHECK(p.stepJump(0.5, 1.5, &at) == 5.0);
+    CHECK(at == 1.0);
+    // A key at the window's start belongs to the window before: (t0, t1].
+    CHECK(p.stepJump(1.0, 1.9) == 0.0);
+    CHECK(p.stepJump(1.9, 2.0) == 13.0);
+    // The same keys eased, and a constant, never jump.
+    CHECK(Param::keyed({0, 1, 2}, {{0, 0}, {3, 4}, {-2, -8}}, KeyInterp::Linear).stepJump(0, 3) ==
+          0.0);
+    CHECK(Param(std::vector<double>{1, 2, 3}).stepJump(0, 3) == 0.0);
+}
