@@ -380,44 +380,16 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         const Collider& c = (*env.colliders)[k];
         const double thick = mKin.colliders[k].thickness;
         const int ci = static_cast<int>(k);
-        // A vertex that ends inside only because an edge neighbour in front of it along the
-        // normal (deeper by more than half their rest length: a column of the cloth landing
-        // end-on) ends inside too waits a round: held, the neighbour stops it through their edge,
-        // and the vertex behind it is then where the solve puts it, not pressed onto the surface
-        // beside the first (which folds a sheet landing edge-first flat on the ground, its
-        // diagonals stretched to 1.14×; bench/README.md). It is added in a later round if it
-        // still ends inside.
-        if (mDeferDepth.size() != n) mDeferDepth.assign(n, -INFINITY);
-        std::fill(mDeferDepth.begin(), mDeferDepth.end(), -INFINITY);
-        if (mOptions.deferStackedContacts && !c.moving)
-            for (size_t i = 0; i < n; ++i) {
-                if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
-                const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
-                const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
-                ContactPoint cp;
-                // The test below: a vertex that would get a contact this round (so that one
-                // waits only behind a neighbour that is held, never round after round).
-                if (endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
-                    cp.distance < thick - kContactSlop && (v1 - cp.velocity).dot(cp.normal) < 0.0)
-                    mDeferDepth[i] = thick - kContactSlop - cp.distance;
-            }
-        std::vector<uint8_t> deferred;
-        for (size_t e = 0; e < mEdges.size() && mOptions.deferStackedContacts && !c.moving; ++e) {
-            const auto [a, b] = mEdges[e];
-            const double da = mDeferDepth[static_cast<size_t>(a)],
-                         db = mDeferDepth[static_cast<size_t>(b)];
-            if (!(da > -INFINITY) || !(db > -INFINITY)) continue;
-            const double half = 0.5 * mEdgeRest[e];
-            if (deferred.empty()) deferred.assign(n, 0);
-            if (da - db > half) deferred[static_cast<size_t>(b)] = 1;
-            if (db - da > half) deferred[static_cast<size_t>(a)] = 1;
-        }
+        // The contacts this round makes with collider k: every free vertex that ends the solve
+        // within its reach, moving in relative to it.
+        struct NewContact {
+            size_t i;
+            ContactPoint cp;
+            Vec3 x1, v1;
+        };
+        std::vector<NewContact> made;
         for (size_t i = 0; i < n; ++i) {
             if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
-            if (!deferred.empty() && deferred[i]) {
-                ++changes; // another round, in which it is looked at again
-                continue;
-            }
             const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
             const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
             ContactPoint cp;
@@ -433,12 +405,41 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                         cp.distance < 0.0;
             if (!found) continue;
             if (!((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
-            setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, c.friction > 0.0);
+            made.push_back({i, cp, x1, v1});
+        }
+        // A vertex that ends inside only because an edge neighbour in front of it along the
+        // normal (deeper by more than half their rest length: a column of the cloth landing
+        // end-on) ends inside too waits a round: held, the neighbour stops it through their edge,
+        // and the vertex behind it is then where the solve puts it, not pressed onto the surface
+        // beside the first (which folds a sheet landing edge-first flat on the ground, its
+        // diagonals stretched to 1.14×; bench/README.md). It is added in a later round if it
+        // still ends inside. Only behind a neighbour that gets its contact this round, so that no
+        // round is spent on a wait that ends in nothing.
+        std::vector<uint8_t> deferred;
+        if (mOptions.deferStackedContacts && !c.moving && made.size() > 1) {
+            mDeferDepth.assign(n, -INFINITY); // per vertex, its depth past the contact surface
+            for (const NewContact& m : made)
+                mDeferDepth[m.i] = thick - kContactSlop - m.cp.distance;
+            for (size_t e = 0; e < mEdges.size(); ++e) {
+                const auto [a, b] = mEdges[e];
+                const double da = mDeferDepth[static_cast<size_t>(a)],
+                             db = mDeferDepth[static_cast<size_t>(b)];
+                if (!(da > -INFINITY) || !(db > -INFINITY)) continue;
+                const double half = 0.5 * mEdgeRest[e];
+                if (deferred.empty()) deferred.assign(n, 0);
+                if (da - db > half) deferred[static_cast<size_t>(b)] = 1;
+                if (db - da > half) deferred[static_cast<size_t>(a)] = 1;
+            }
+        }
+        for (const NewContact& m : made) {
+            ++changes; // a contact made, or one that waits for another round
+            if (!deferred.empty() && deferred[m.i]) continue;
+            const size_t i = m.i;
+            setContact(i, ci, m.cp, m.x1, t1, thick, t1, h, x0, v0, m.v1, c.friction > 0.0);
             mContactMu[i] = c.friction;
-            mContactImpulse[i] = -(v1 - cp.velocity).dot(cp.normal); // the approach it had
+            mContactImpulse[i] = -(m.v1 - m.cp.velocity).dot(m.cp.normal); // the approach it had
             mFoundInside[i] = 1;
             ++st.contactAdded;
-            ++changes;
         }
     }
     syncFriction(v0, true);
