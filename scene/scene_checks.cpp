@@ -260,18 +260,15 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     for (const solver::Collider& c : scene.colliders) {
         if (c.shape != solver::ColliderShape::Sphere && c.shape != solver::ColliderShape::Capsule)
             continue;
-        double at = 0.0, atB = 0.0;
-        const double jumpA = c.a.stepJump(t0, t1, &at);
-        const double jumpB =
-            c.shape == solver::ColliderShape::Capsule ? c.b.stepJump(t0, t1, &atB) : 0.0;
-        const bool isA = jumpA >= jumpB;
-        const double jump = std::max(jumpA, jumpB);
+        double at = 0.0;
+        bool ofB = false;
+        const double jump = solver::colliderStepJump(c, t0, t1, at, ofB);
         if (jump > solver::kTeleportTolerance)
             warn(c, teleport("[[collider]] '" + c.name + "'",
                              c.shape == solver::ColliderShape::Sphere ? "center"
-                             : isA                                    ? "a"
-                                                                      : "b",
-                             jump, isA ? at : atB));
+                             : ofB                                    ? "b"
+                                                                      : "a",
+                             jump, at));
     }
     for (const solver::Collider& c : scene.colliders) {
         const std::string what = "[[collider]] '" + c.name + "'";

@@ -43,6 +43,14 @@ ColliderPose colliderPose(const Collider& c, double t) {
     return p;
 }
 
+double colliderStepJump(const Collider& c, double t0, double t1, double& at, bool& ofB) {
+    double atA = 0.0, atB = 0.0;
+    const double a = c.a.stepJump(t0, t1, &atA), b = c.b.stepJump(t0, t1, &atB);
+    ofB = b > a;
+    at = ofB ? atB : atA;
+    return std::max(a, b);
+}
+
 ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x, int hint) {
     ContactPoint cp;
     switch (pose.shape) {

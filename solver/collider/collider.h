@@ -60,4 +60,9 @@ ColliderPose colliderPose(const Collider& c, double t);
 // first; the answer is the same with or without it.
 ContactPoint queryCollider(const ColliderPose& pose, const Vec3& x, int hint = -1);
 
+// The largest jump the collider's step-keyed position makes within (t0, t1] (m: its `a`, or its
+// `b`; fields::Param::stepJump), the key's time in `at`, and whether it was `b` in `ofB`; 0 when
+// none (a teleport: scene checks warn of it, frame trouble blames the scene for it).
+double colliderStepJump(const Collider& c, double t0, double t1, double& at, bool& ofB);
+
 } // namespace gale::solver

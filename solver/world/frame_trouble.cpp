@@ -48,13 +48,10 @@ std::string FrameTrouble::text() const {
     if (count > 1)
         s += " (" + std::to_string(count) +
              (kind == Kind::OverStretch ? " edges past the limit)" : " vertices inside)");
-    // The scene's: held vertices (pulled apart, or held inside), or a collider's teleport alone.
-    const bool held = forcedBy.find("holding") != std::string::npos ||
-                      forcedBy.find("jumped") == std::string::npos;
     s += ", forced by " + forcedBy +
-         (!scene ? ""
-          : held ? " (the scene's: held vertices cannot follow)"
-                 : " (the scene's: no cloth follows a teleport)");
+         (!scene      ? ""
+          : !teleport ? " (the scene's: held vertices cannot follow)"
+                      : " (the scene's: no cloth follows a teleport)");
     return s;
 }
 
@@ -84,14 +81,13 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
     };
     // A collider that jumped in this frame (step keys): what it forces is the scene's, said so.
     auto jumped = [&](int c, std::string& forcedBy) {
-        double at = 0.0, atB = 0.0;
-        const Collider& k = colliders[static_cast<size_t>(c)];
-        const double a = k.a.stepJump(frameStart, t, &at), b = k.b.stepJump(frameStart, t, &atB);
-        const double jump = std::max(a, b);
+        double at = 0.0;
+        bool ofB = false;
+        const double jump =
+            colliderStepJump(colliders[static_cast<size_t>(c)], frameStart, t, at, ofB);
         if (!(jump > kTeleportTolerance)) return false;
         char buf[96];
-        std::snprintf(buf, sizeof buf, " (it jumped %.3g m at t = %.4g s: step keys)", jump,
-                      a >= b ? at : atB);
+        std::snprintf(buf, sizeof buf, " (it jumped %.3g m at t = %.4g s: step keys)", jump, at);
         forcedBy += buf;
         return true;
     };
@@ -125,7 +121,7 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
             for (int v : {s.vertex, s.other})
                 if (c < 0) c = near(v);
             s.forcedBy = c >= 0 ? colliderName(c) : "the solver";
-            if (c >= 0 && jumped(c, s.forcedBy)) s.scene = true;
+            if (c >= 0 && jumped(c, s.forcedBy)) s.scene = s.teleport = true;
         }
         out.push_back(s);
     }
@@ -150,8 +146,9 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
         if (in.count == 0) continue;
         in.position = pos(in.vertex);
         in.forcedBy = colliderName(static_cast<int>(c));
-        if (jumped(static_cast<int>(c), in.forcedBy)) in.scene = true;
+        if (jumped(static_cast<int>(c), in.forcedBy)) in.scene = in.teleport = true;
         if (heldInside) {
+            in.teleport = false; // held there: the held vertices' reason
             in.forcedBy += std::string(" and the ") + holder(held[in.vertex]) + " holding vertex " +
                            std::to_string(in.vertex) + " inside it";
             in.scene = true;

@@ -26,6 +26,7 @@ struct FrameTrouble {
     // "collider 'ball'" (and, inside, " and the pin holding vertex 7 inside it"), "the solver".
     std::string forcedBy;
     bool scene = false; // forced by the scene (held vertices pulled apart, or held inside)
+    bool teleport = false; // ... by a collider's step keys alone (it jumped in this frame)
     // One line for stderr and run.json's events, e.g. "over-stretched: edge 12-13 at 4.1× its
     // rest length (limit 3×) at (0.1, 0.9, 0), forced by collider 'ball'".
     std::string text() const;
