@@ -133,10 +133,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     for (const scene::SceneError& w : scene::runWarnings(mScene, bodies, mFirst, mLast)) {
         report += w.render() + '\n';
         // As the bodies' warnings: "file:line:col: message", without the source line.
-        mWarnings.push_back(w.file +
-                            (w.line > 0 ? ":" + std::to_string(w.line) + ":" + std::to_string(w.col)
-                                        : std::string()) +
-                            ": " + w.message);
+        mWarnings.push_back(w.location() + ": " + w.message);
     }
 
     mWorld = std::make_unique<solver::World>(scene::worldSettings(mScene, s.threads));

@@ -22,10 +22,14 @@ SceneError sceneErrorAt(const std::string& file, int line, int col, std::string 
     return e;
 }
 
-std::string SceneError::render() const {
+std::string SceneError::location() const {
     std::string out = file.empty() ? std::string("<scene>") : file;
     if (line > 0) out += ":" + std::to_string(line) + ":" + std::to_string(col > 0 ? col : 1);
-    out += (warning ? ": warning: " : ": error: ") + message;
+    return out;
+}
+
+std::string SceneError::render() const {
+    std::string out = location() + (warning ? ": warning: " : ": error: ") + message;
     if (line > 0 && !sourceLine.empty()) {
         out += "\n    ";
         for (char c : sourceLine) out += (static_cast<unsigned char>(c) < 0x20 && c != '\t') ? ' ' : c;

@@ -21,6 +21,8 @@ struct SceneError {
     // 0), then the source line
     // with a caret under the column, then "note: ..." lines.
     std::string render() const;
+    // "file:line:col" ("<scene>" for no file; without :line:col when line is 0).
+    std::string location() const;
 };
 
 // An error at file:line:col of `file`, its source line read from the file.
