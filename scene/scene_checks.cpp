@@ -2,8 +2,8 @@
 #include "scene/scene_checks.h"
 
 #include "solver/collider/moving_collider.h"
-#include "solver/contact/intersect.h"
 #include "solver/world/frame_trouble.h"
+#include "solver/world/self_collision.h"
 
 #include <algorithm>
 #include <cmath>
@@ -228,28 +228,18 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     for (size_t j = 0; j < scene.hairs.size() && scene.cloths.size() + j < bodies.size(); ++j) {
         const solver::Body& hair = *bodies[scene.cloths.size() + j];
         if (!hair.collision().self) continue;
-        const std::vector<double> x(hair.positions().data(),
-                                    hair.positions().data() + hair.positions().size());
         for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
             const solver::Body& cloth = *bodies[i];
-            if (!cloth.collision().self || !cloth.collisionTriangles()) continue;
-            const std::vector<double> y(cloth.positions().data(),
-                                        cloth.positions().data() + cloth.positions().size());
-            const auto through =
-                solver::contact::crossingSegments(x, hair.edges(), y, *cloth.collisionTriangles());
-            if (through.empty()) continue;
-            std::vector<uint8_t> seen(hair.edges().size(), 0);
-            int segments = 0;
-            for (const auto& [seg, tri] : through) segments += !seen[seg]++;
-            const auto [a, b] = hair.edges()[static_cast<size_t>(through[0].first)];
-            const Vec3 at =
-                0.5 * (hair.positions().segment<3>(3 * a) + hair.positions().segment<3>(3 * b));
+            if (!cloth.collision().self) continue;
+            const solver::HairThroughCloth through = solver::hairThroughCloth(hair, cloth);
+            if (through.segments == 0) continue;
             char where[96];
-            std::snprintf(where, sizeof where, "(%.4g, %.4g, %.4g)", at.x(), at.y(), at.z());
+            std::snprintf(where, sizeof where, "(%.4g, %.4g, %.4g)", through.at.x(), through.at.y(),
+                          through.at.z());
             SceneError e = sceneErrorAt(
                 scene.wind.path, scene.hairs[j].line, scene.hairs[j].col,
                 "[[hair]] '" + scene.hairs[j].name + "' starts through [[cloth]] '" +
-                    scene.cloths[i].name + "': " + std::to_string(segments) +
+                    scene.cloths[i].name + "': " + std::to_string(through.segments) +
                     " segment(s) cross it (the first at " + where +
                     "); the run lets them through the cloth until they are clear of it, so the "
                     "strands end up on either side: start the hair clear of the cloth");

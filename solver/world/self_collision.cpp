@@ -595,6 +595,25 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
     mStats.failSafeSeconds += seconds(start);
 }
 
+HairThroughCloth hairThroughCloth(const Body& hair, const Body& cloth) {
+    HairThroughCloth out;
+    if (!cloth.collisionTriangles()) return out;
+    const VecX& xh = hair.positions();
+    const VecX& xc = cloth.positions();
+    const auto through = contact::crossingSegments(
+        std::vector<double>(xh.data(), xh.data() + xh.size()), hair.edges(),
+        std::vector<double>(xc.data(), xc.data() + xc.size()), *cloth.collisionTriangles());
+    if (through.empty()) return out;
+    std::vector<uint8_t> seen(hair.edges().size(), 0);
+    for (const auto& [seg, tri] : through) out.segments += !seen[static_cast<size_t>(seg)]++;
+    const auto [a, b] = hair.edges()[static_cast<size_t>(through[0].first)];
+    out.a = a;
+    out.b = b;
+    out.at = 0.5 * (vec3At(xh.data(), static_cast<size_t>(a)) +
+                    vec3At(xh.data(), static_cast<size_t>(b)));
+    return out;
+}
+
 void SelfCollision::setUntangleHair(bool on) {
     mUntangleHair = on;
     if (!on && !mTangled.empty()) {

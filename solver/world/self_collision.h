@@ -55,6 +55,16 @@ struct SelfCollisionSettings {
     double planeReach = 1.5;
 };
 
+// A hair's segments through a cloth's triangles at their current positions (the start shape's
+// checks: the World's first-frame event and `gale check`'s warning): how many segments cross,
+// and the first one's ends and midpoint. segments == 0: none.
+struct HairThroughCloth {
+    int segments = 0;
+    int a = -1, b = -1;
+    Vec3 at = Vec3::Zero();
+};
+HairThroughCloth hairThroughCloth(const Body& hair, const Body& cloth);
+
 class SelfCollision {
 public:
     explicit SelfCollision(SelfCollisionSettings settings = {}) : mSettings(settings) {}
@@ -103,9 +113,14 @@ public:
     // The crossing moves along the strand and leaves it. Without crossings the pass is what it
     // is without this (the search costs a tree over the cloth's triangles a pass).
     // tangledBodies(): per body, whether a segment of it crossed at the last pass's start.
+    // markTangled(): body k starts through a cloth (the World's start check), so that its solve
+    // before the first pass already keeps off the cloth; each pass then finds its own.
     void setUntangleHair(bool on);
     bool untanglingHair() const { return mUntangleHair; }
     const std::vector<uint8_t>& tangledBodies() const { return mTangledBodies; }
+    void markTangled(size_t body) {
+        if (mUntangleHair && body < mTangledBodies.size()) mTangledBodies[body] = 1;
+    }
 
     // A pair of primitives as four global vertices and signed weights α: the pair's relative
     // position is Σ α_k x_k (vertex − triangle point, or point on one edge − point on the other).

@@ -3,7 +3,6 @@
 #include "solver/world/world.h"
 
 #include "solver/collider/moving_collider.h"
-#include "solver/contact/intersect.h"
 #include "solver/mesh/mesh_sequence.h"
 
 #include <tbb/info.h>
@@ -141,34 +140,23 @@ void World::setUpSelfCollision(FrameStats& fs) {
     // through the cloth where it crosses until it is clear (SelfCollision::setUntangleHair):
     // contact would hold each such segment where it crosses, and a cloth moving away then drags
     // the strand (the hard scenes' hair at 6-70×: docs/solver.md).
-    mHairTangled.assign(mSelfBodies.size() - mClothBodies, 0);
     // Every pass looks for hair through cloth, not only after such a start: a strand that starts
     // touching a cloth (no side to keep) can end a step through it, and is then let through too.
-    if (mSettings.untangleHair && !mHairTangled.empty()) mSelf->setUntangleHair(true);
+    if (mSettings.untangleHair && mSelfBodies.size() > mClothBodies) mSelf->setUntangleHair(true);
     for (size_t h = mClothBodies; h < mSelfBodies.size(); ++h) {
         const Body& hair = *mBodies[mSelfBodies[h]];
-        const std::vector<double> x(hair.positions().data(),
-                                    hair.positions().data() + hair.positions().size());
         for (size_t k = 0; k < mClothBodies; ++k) {
             const Body& cloth = *mBodies[mSelfBodies[k]];
-            const std::vector<double> y(cloth.positions().data(),
-                                        cloth.positions().data() + cloth.positions().size());
-            const auto through =
-                contact::crossingSegments(x, hair.edges(), y, *cloth.collisionTriangles());
-            if (through.empty()) continue;
-            if (mSettings.untangleHair) mHairTangled[h - mClothBodies] = 1;
-            std::vector<uint8_t> seen(hair.edges().size(), 0);
-            int segments = 0;
-            for (const auto& [seg, tri] : through) segments += !seen[seg]++;
-            const auto [a, b] = hair.edges()[static_cast<size_t>(through[0].first)];
-            const Vec3 at = 0.5 * (vec3At(hair.positions().data(), static_cast<size_t>(a)) +
-                                   vec3At(hair.positions().data(), static_cast<size_t>(b)));
+            const HairThroughCloth through = hairThroughCloth(hair, cloth);
+            if (through.segments == 0) continue;
+            mSelf->markTangled(h);
             std::snprintf(buf, sizeof buf,
                           "hair-cloth collision: the start shape has %d segment(s) through cloth "
                           "'%s' (the first, %d-%d, at (%.4g, %.4g, %.4g)); the strands are let "
                           "through the cloth there until they are clear of it (start the hair "
                           "clear of the cloth to keep it on its side)",
-                          segments, cloth.name().c_str(), a, b, at.x(), at.y(), at.z());
+                          through.segments, cloth.name().c_str(), through.a, through.b,
+                          through.at.x(), through.at.y(), through.at.z());
             fs.bodies[mSelfBodies[h]].events.push_back(buf);
         }
     }
@@ -226,10 +214,6 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         }
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
-        // A hair through cloth at this interval's start keeps its solve off the cloth.
-        if (mSelf->untanglingHair())
-            for (size_t h = 0; h < mHairTangled.size(); ++h)
-                mHairTangled[h] = mSelf->tangledBodies()[mClothBodies + h];
         bool stretched = false;
         double worst = 0.0;
         for (size_t k = 0; k < n; ++k) {
@@ -315,7 +299,8 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
 
 const std::vector<Collider>* World::hairColliders(size_t k) const {
     if (k < mClothBodies || k - mClothBodies >= mHairColliders.size()) return nullptr;
-    if (k - mClothBodies < mHairTangled.size() && mHairTangled[k - mClothBodies]) return nullptr;
+    // A hair through cloth at the last pass's start (or the run's) keeps its solve off the cloth.
+    if (mSelf && mSelf->untanglingHair() && mSelf->tangledBodies()[k]) return nullptr;
     const std::vector<Collider>& list = mHairColliders[k - mClothBodies];
     return list.empty() ? nullptr : &list;
 }

@@ -191,10 +191,6 @@ private:
     size_t mClothBodies = 0;
     std::vector<std::shared_ptr<MovingMeshContact>> mClothContacts;
     std::vector<std::vector<Collider>> mHairColliders;
-    // Per hair (mSelfBodies after the cloth): a segment crossed a cloth at the start, or at the
-    // last pass's (SelfCollision::setUntangleHair). Its solve then meets the scene's colliders
-    // only, so that it does not hold the strand where it crosses either.
-    std::vector<uint8_t> mHairTangled;
     // Per colliding body (mSelfBodies), the cloth contact planes of the last accepted pass.
     std::vector<std::vector<ClothContactPlane>> mClothPlanes;
 };
