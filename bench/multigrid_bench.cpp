@@ -1,6 +1,6 @@
 // gale_bench_multigrid: the cloth system's multigrid preconditioner at production resolution
 // (issue 26) — CG iterations, set-up and solve time per vertex and bytes per vertex from 32² to
-// 256² (grid and irregular sheets) at h = 1/24 and 1/240 s, on 1 and 2 threads, for smoothed
+// 256² (grid, irregular and plate sheets) at h = 1/24 and 1/240 s, on 1 and 2 threads, for smoothed
 // aggregation with rotations against the plain aggregation baseline measured in the same run
 // (and hypre's BoomerAMG on the same matrices when built with it); speed against error.
 //   gale_bench_multigrid [--quick] [--only scaling|error] [--size N]
@@ -30,6 +30,7 @@
 using namespace gale::solver;
 using gale::solver::testing::ClothSystem;
 using gale::solver::testing::makeClothSystem;
+using gale::solver::testing::SheetOptions;
 
 namespace {
 
@@ -204,11 +205,17 @@ void scalingBench(bool quick, int onlySize) {
                 "B/vertex", "peak_B/v", "maxdiff");
     const std::vector<int> sizes =
         quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128, 256};
-    for (bool irregular : {false, true})
+    // The sheets: wavy edge springs on a grid or an irregular mesh, and the flat grid with the
+    // cloth's bending and nothing across the springs, a plate out of plane (test_sheets.h).
+    for (int sheet = 0; sheet < 3; ++sheet)
         for (double h : {1.0 / 24.0, 1.0 / 240.0})
             for (int n : sizes) {
                 if (onlySize && n != onlySize) continue;
-                const ClothSystem s = makeClothSystem(n, h, irregular, true);
+                const bool irregular = sheet == 1;
+                SheetOptions opt =
+                    sheet == 2 ? gale::solver::testing::plateSheet() : SheetOptions();
+                opt.irregular = irregular;
+                const ClothSystem s = makeClothSystem(n, h, opt);
                 const double nv = static_cast<double>(s.A.size());
                 const int repeats = n >= 256 ? 1 : 3;
                 const Outcome base = runSolve(s, kPlain, 1e-3, 1, repeats);
@@ -216,9 +223,12 @@ void scalingBench(bool quick, int onlySize) {
                 auto row = [&](const char* name, int threads, const Outcome& o, double diff) {
                     std::printf(
                         "%-9s 1/%-5.0f %5d %-19s %3d %5d %6d %9.3f %9.3f %9.2f %8.0f %8.0f %7.1e\n",
-                        irregular ? "irregular" : "grid", 1.0 / h, n, name, threads, o.iterations,
-                        o.levels, 1e6 * o.setup / nv, 1e6 * o.solve / nv,
-                        (o.setup + o.solve) / baseTotal, o.bytes / nv, o.peakBytes / nv, diff);
+                        sheet == 2  ? "plate"
+                        : irregular ? "irregular"
+                                    : "grid",
+                        1.0 / h, n, name, threads, o.iterations, o.levels, 1e6 * o.setup / nv,
+                        1e6 * o.solve / nv, (o.setup + o.solve) / baseTotal, o.bytes / nv,
+                        o.peakBytes / nv, diff);
                     std::fflush(stdout);
                 };
                 row(kPlain.name, 1, base, 0.0);
