@@ -34,19 +34,12 @@ struct SheetOptions {
     bool irregular = false;
     bool constraints = true;
     unsigned seed = 5;
-    // The quadratic bending of Bergou, Wardetzky, Harmon, Zorin & Grinspun (2006) that the
-    // cloth uses (N m; 0: none), E = ½ k_b Σ_i |Σ_j w_ij (x_j − x_i)|² / A_i (cotangent weights
-    // w_ij, A_i a third of the triangles' area round i): K = k_b Lᵀ A⁻¹ L ⊗ I₃ couples vertices
-    // two edges apart.
-    double bend = 0.0;
     double transverse = 0.01; // the springs' stiffness across them, a fraction of k
     bool flat = false;        // else the sheet is slightly wavy out of plane
 };
 
-// A flat sheet with bending and nothing across the springs (`plate`) is what a cloth's own
-// matrix is out of plane where its membrane carries no tension: a plate, whose bending outgrows
-// the mass as (1/dx)⁴ at a frame-size step, and much harder for the multigrid than the wavy
-// springs (bench/README.md, "The cloth's own matrices: the counts do grow").
+// flat with transverse = 0: out of plane the springs hold nothing, only the mass does; with a
+// cloth's bending added (the multigrid benchmark's `plate`) that is a slack cloth's system.
 inline ClothSystem makeClothSystem(int n, double h, const SheetOptions& o) {
     const bool irregular = o.irregular, constraints = o.constraints;
     const unsigned seed = o.seed;
@@ -92,50 +85,9 @@ inline ClothSystem makeClothSystem(int n, double h, const SheetOptions& o) {
     }
     std::sort(pairs.begin(), pairs.end());
     pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    const std::vector<std::pair<int, int>> edges = pairs;
-    // Bending: the rows of L (cotangent weights), then the entries of h² k_b Lᵀ A⁻¹ L.
-    std::vector<std::pair<std::pair<int, int>, double>> bendEntries;
-    if (o.bend > 0.0) {
-        std::vector<std::vector<std::pair<int, double>>> L(nv);
-        auto addW = [&](int i, int j, double c) {
-            for (auto& [k, v] : L[i])
-                if (k == j) {
-                    v += c;
-                    return;
-                }
-            L[i].push_back({j, c});
-        };
-        for (size_t t = 0; t < s.triangles.size(); t += 3) {
-            const int* tri = &s.triangles[t];
-            for (int q = 0; q < 3; ++q) { // corner q, opposite the edge (a, b)
-                const int k = tri[q], a = tri[(q + 1) % 3], b = tri[(q + 2) % 3];
-                const Vec3 u = pos(a) - pos(k), v = pos(b) - pos(k);
-                const double cot = u.dot(v) / u.cross(v).norm();
-                addW(a, b, 0.5 * cot);
-                addW(b, a, 0.5 * cot);
-            }
-        }
-        for (int i = 0; i < nv; ++i) {
-            double sum = 0.0;
-            for (const auto& [j, c] : L[i]) sum += c;
-            L[i].push_back({i, -sum});
-        }
-        for (int i = 0; i < nv; ++i) { // (Lᵀ A⁻¹ L)_jk = Σ_i L_ij L_ik / A_i, A_i = m_i / σ
-            const double scale = h * h * o.bend * sigma / mass[i];
-            for (const auto& [j, a] : L[i])
-                for (const auto& [k, b] : L[i]) {
-                    bendEntries.push_back({{j, k}, scale * a * b});
-                    if (j < k) pairs.push_back({j, k});
-                }
-        }
-        std::sort(pairs.begin(), pairs.end());
-        pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    }
     s.A.build(nv, pairs);
     for (int v = 0; v < nv; ++v) s.A.addDiagonal(s.A.diagonalSlot(v), mass[v]);
-    for (const auto& [jk, value] : bendEntries)
-        s.A.addBlock(s.A.slot(jk.first, jk.second), value * Mat3::Identity());
-    for (const auto& p : edges) {
+    for (const auto& p : pairs) {
         const Vec3 d = (pos(p.second) - pos(p.first)).normalized();
         const Mat3 B =
             h * h * k * (d * d.transpose() + o.transverse * (Mat3::Identity() - d * d.transpose()));
@@ -174,16 +126,6 @@ inline ClothSystem makeClothSystem(int n, double h, bool irregular, bool constra
     o.constraints = constraints;
     o.seed = seed;
     return makeClothSystem(n, h, o);
-}
-
-// The plate above: flat, the cloth's bending (1e-5 N m, the wind-onset flag's), no stiffness
-// across the springs.
-inline SheetOptions plateSheet() {
-    SheetOptions o;
-    o.bend = 1e-5;
-    o.transverse = 0.0;
-    o.flat = true;
-    return o;
 }
 
 } // namespace gale::solver::testing
