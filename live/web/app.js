@@ -298,6 +298,7 @@ function events() {
       simRun = s.run;
       live.simRun = s.run;
       previousRun = s.previous || null;
+      live.previousRun = previousRun;
     }
     if (s.run !== undefined && s.run !== simRun) return;
     $('simulate').textContent = s.running || s.on ? 'Stop' : 'Simulate';
