@@ -309,6 +309,7 @@ double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool si
     const size_t n3 = static_cast<size_t>(y.size());
     const size_t chunks = (n3 + kReduceChunk - 1) / kReduceChunk;
     mPartial.assign(chunks, 0.0);
+    const bool flexible = mMultigrid.settings().kCycle;
     double rz = mMultigrid.apply(mR.data(), mZ.data());
     mP = mZ;
     while (it < maxIterations) {
@@ -336,8 +337,12 @@ double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool si
         ++it;
         rNorm = std::sqrt(rr);
         if (rNorm <= target || !std::isfinite(rNorm)) break;
+        // Flexible CG (Polak–Ribière, β = r_newᵀ(z_new − z_old) / r_oldᵀz_old) when the K-cycle
+        // makes the preconditioner depend on r; else Fletcher–Reeves, β = r_newᵀz_new /
+        // r_oldᵀz_old.
+        const double rzOld = flexible ? deterministicDot(mR.data(), mZ.data(), n3) : 0.0;
         const double rzNew = mMultigrid.apply(mR.data(), mZ.data()); // z = B r, rᵀz
-        const double beta = rzNew / rz;
+        const double beta = (rzNew - rzOld) / rz;
         rz = rzNew;
         parallelChunks(n3, kReduceChunk, [&](size_t b, size_t e) {
             for (size_t k = b; k < e; ++k) mP[k] = mZ[k] + beta * mP[k];

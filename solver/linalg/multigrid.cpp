@@ -500,7 +500,7 @@ size_t BlockMultigrid::bytes() const {
             v(L.agg.members);
         v(L.P.start), v(L.P.cols), v(L.P.val), v(L.P.tStart), v(L.P.tRow), v(L.P.tSlot);
         v(L.plainAgg), v(L.plainStart), v(L.plainMembers), v(L.coarseSlot), v(L.gatherStart), v(L.gather);
-        v(L.r), v(L.x), v(L.t);
+        v(L.r), v(L.x), v(L.t), v(L.kr), v(L.kc), v(L.kv), v(L.kw);
     }
     v(mPartial), v(mSrcSlot), v(mConstrainedRows), v(mKind), v(mNormal), v(mPositions);
     b += static_cast<size_t>(mCoarseDense.size()) * 2 * sizeof(double); // and its factor
@@ -744,7 +744,7 @@ void BlockMultigrid::cyclePlainCoarse(int l, bool pull) {
             for (int q = 0; q < 3; ++q) C.r[3 * I + q] = s[q];
         }
     });
-    cycle(l + 1);
+    coarseCycle(l + 1);
     // x += α S P_tent e.
     const double alpha = mSettings.coarseWeight;
     parallelChunks(static_cast<size_t>(L.a.n), 512, [&](size_t i0, size_t i1) {
@@ -796,10 +796,57 @@ void BlockMultigrid::cycle(int l) {
         });
     }
     L.P.restrictTo(L.t.data(), C.r.data());
-    cycle(l + 1);
+    coarseCycle(l + 1);
     // x += α P e.
     L.P.prolongAdd(C.x.data(), mSettings.coarseWeight, L.xp);
     for (int s = 0; s < mSettings.sweeps; ++s) smooth(l, false, false);
+}
+
+// The coarse correction of level c (c ≥ 1) for its r, into its x. With Settings::kCycle and a
+// level below c, Notay & Vassilevski's K-cycle (2008, Algorithm 2.1 with two inner steps): two
+// steps of flexible CG on A_c x = r, each preconditioned by one cycle of level c,
+//   c₁ = B r, v₁ = A c₁, ρ₁ = c₁ᵀv₁, α₁ = c₁ᵀr, r̃ = r − (α₁/ρ₁) v₁;
+//   if ‖r̃‖ ≤ t‖r‖ (t = 0.25): x = (α₁/ρ₁) c₁; else
+//   c₂ = B r̃, v₂ = A c₂, γ = c₂ᵀv₁, β = c₂ᵀv₂, α₂ = c₂ᵀr̃, ρ₂ = β − γ²/ρ₁,
+//   x = (α₁/ρ₁ − γα₂/(ρ₁ρ₂)) c₁ + (α₂/ρ₂) c₂.
+// Dot products in deterministicDot's order: the same bits for any thread count.
+void BlockMultigrid::coarseCycle(int c) {
+    if (!mSettings.kCycle || c + 1 >= static_cast<int>(mLevels.size())) {
+        cycle(c);
+        return;
+    }
+    Level& C = mLevels[c];
+    const size_t n3 = 3 * static_cast<size_t>(C.a.n);
+    C.kr.assign(C.r.begin(), C.r.end());
+    C.kc.resize(n3);
+    C.kv.resize(n3);
+    C.kw.resize(n3);
+    cycle(c);
+    std::copy(C.x.begin(), C.x.end(), C.kc.begin());
+    C.a.multiply(C.kc.data(), C.kv.data());
+    const double rho1 = deterministicDot(C.kc.data(), C.kv.data(), n3);
+    const double a1 = deterministicDot(C.kc.data(), C.kr.data(), n3);
+    if (!(rho1 > 0.0) || !std::isfinite(rho1)) return; // x = c₁ (one cycle)
+    const double s1 = a1 / rho1;
+    for (size_t k = 0; k < n3; ++k) C.r[k] = C.kr[k] - s1 * C.kv[k];
+    const double r0 = deterministicDot(C.kr.data(), C.kr.data(), n3);
+    const double rt = deterministicDot(C.r.data(), C.r.data(), n3);
+    if (rt <= 0.0625 * r0) {
+        for (size_t k = 0; k < n3; ++k) C.x[k] = s1 * C.kc[k];
+        return;
+    }
+    cycle(c); // c₂ = B r̃
+    C.a.multiply(C.x.data(), C.kw.data());
+    const double gamma = deterministicDot(C.x.data(), C.kv.data(), n3);
+    const double beta = deterministicDot(C.x.data(), C.kw.data(), n3);
+    const double a2 = deterministicDot(C.x.data(), C.r.data(), n3);
+    const double rho2 = beta - gamma * gamma / rho1;
+    if (!(rho2 > 0.0) || !std::isfinite(rho2)) {
+        for (size_t k = 0; k < n3; ++k) C.x[k] = s1 * C.kc[k];
+        return;
+    }
+    const double w1 = s1 - gamma * a2 / (rho1 * rho2), w2 = a2 / rho2;
+    for (size_t k = 0; k < n3; ++k) C.x[k] = w1 * C.kc[k] + w2 * C.x[k];
 }
 
 const double* BlockMultigrid::normalOf(int i) const {

@@ -122,6 +122,13 @@ public:
         // the wind-onset flag's 256² frame costs 0.37 s instead of 0.62 (bench/README.md,
         // "Smoothed aggregation with translations only").
         bool rotations = false;
+        // K-cycle (Notay & Vassilevski 2008): each coarse level but the last solved by two
+        // steps of flexible CG preconditioned by its own cycle, instead of one cycle. The
+        // preconditioner is then not a fixed linear map: CG uses the flexible (Polak–Ribière) β.
+        // On with the rotations (setKind): a slack cloth's plate-like rows at 256², 81 → 42 CG
+        // iterations; on a taut sheet, whose counts were already bounded, it only adds work
+        // (bench/README.md, "A K-cycle").
+        bool kCycle = false;
         double prolongatorDamping = 4.0 / 3.0; // ω ρ(D⁻¹Â)
         int powerIterations = 8;    // power steps of the ρ(D⁻¹Â) estimate
     };
@@ -131,12 +138,13 @@ public:
     static Settings& defaults();
 
     Settings& settings() { return mSettings; }
-    // Sets smoothed, smoothedMinRows and rotations for `kind` (Automatic: the defaults'
-    // threshold; SmoothedRotations: smoothed at every size with the rotations).
+    // Sets smoothed, smoothedMinRows, rotations and kCycle for `kind` (Automatic: the defaults'
+    // threshold; SmoothedRotations: smoothed at every size with the rotations and the K-cycle).
     void setKind(MultigridKind kind) {
         mSettings.smoothed = kind != MultigridKind::Plain;
         mSettings.smoothedMinRows = kind == MultigridKind::Automatic ? defaults().smoothedMinRows : 0;
         mSettings.rotations = kind == MultigridKind::SmoothedRotations || defaults().rotations;
+        mSettings.kCycle = kind == MultigridKind::SmoothedRotations || defaults().kCycle;
     }
 
     // Vertex positions (m, 3 per vertex of A, A's order) for the rotations of the near-null
@@ -208,6 +216,7 @@ private:
         // aggregate, the next level's slot of each slot and its inverse (the slots summed).
         std::vector<int> plainAgg, plainStart, plainMembers, coarseSlot, gatherStart, gather;
         std::vector<double> r, x, t;   // 3n work vectors (level 0: t only)
+        std::vector<double> kr, kc, kv, kw; // K-cycle work vectors (coarse levels, kCycle)
         const double* rp = nullptr;    // the r and x in use: r, x, or at level 0 apply's
         double* xp = nullptr;
     };
@@ -225,6 +234,7 @@ private:
     // row by row (bsrUpperResidualRows; no slot map of transposed blocks is kept to push it).
     bool smooth(int l, bool forward, bool fromZero, bool residual = false);
     void cycle(int l);
+    void coarseCycle(int c); // level c's correction from its r: one cycle, or the K-cycle's two
     void cyclePlainCoarse(int l, bool pull);
 
     Settings mSettings = defaults();
