@@ -333,6 +333,25 @@ MgRun solveMg(const ClothSystem& s, double tol, bool smoothed, bool rotations, i
     return out;
 }
 
+// An irregular n×n sheet with a pinned 5×5 block (aggregates with no free direction: dead coarse
+// unknowns) and every other vertex of rows j0 … j1 − 1, columns 2 … i1 − 1, on a plane; ref
+// receives LDLᵀ's answer.
+ClothSystem blockAndPlanes(int n, int j0, int j1, int i1, VecX& ref) {
+    ClothSystem s = makeClothSystem(n, 1.0 / 24.0, true, true);
+    for (int j = 5; j < 10; ++j)
+        for (int i = 5; i < 10; ++i) s.c.kind[j * n + i] = 1;
+    const Vec3 nrm = Vec3(0.3, 0.1, 1.0).normalized();
+    for (int j = j0; j < j1; ++j)
+        for (int i = 2; i < i1; i += 2) {
+            s.c.kind[j * n + i] = 2;
+            vec3At(s.c.normal.data(), j * n + i) = nrm;
+        }
+    FilteredSolver direct;
+    ref = VecX::Zero(s.b.size());
+    REQUIRE(direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
+    return s;
+}
+
 } // namespace
 
 TEST_CASE("multigrid: smoothed aggregation, translations alone or with rotations, agrees with "
@@ -412,22 +431,11 @@ TEST_CASE("multigrid: setKind picks the hierarchy and its near-null space", "[mu
 
 TEST_CASE("multigrid: the K-cycle with flexible CG agrees with LDLT, on 1 and 2 threads alike",
           "[multigrid]") {
-    // A pinned block (dead coarse unknowns) and plane filters as below, on an irregular sheet
-    // deep enough for K-cycle levels (a level with another under it): the nonlinear
-    // preconditioner and the flexible β still converge to the direct answer, bit for bit on any
-    // thread count.
-    ClothSystem s = makeClothSystem(48, 1.0 / 24.0, true, true);
-    for (int j = 5; j < 10; ++j)
-        for (int i = 5; i < 10; ++i) s.c.kind[j * 48 + i] = 1;
-    const Vec3 nrm = Vec3(0.3, 0.1, 1.0).normalized();
-    for (int j = 20; j < 30; ++j)
-        for (int i = 2; i < 30; i += 2) {
-            s.c.kind[j * 48 + i] = 2;
-            vec3At(s.c.normal.data(), j * 48 + i) = nrm;
-        }
-    FilteredSolver direct;
-    VecX ref = VecX::Zero(s.b.size());
-    REQUIRE(direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
+    // A pinned block and plane filters (blockAndPlanes) on an irregular sheet deep enough for
+    // K-cycle levels (a level with another under it): the nonlinear preconditioner and the
+    // flexible β still converge to the direct answer, bit for bit on any thread count.
+    VecX ref;
+    const ClothSystem s = blockAndPlanes(48, 20, 30, 30, ref);
     for (bool rotations : {false, true}) {
         const MgRun one = solveMg(s, 1e-9, true, rotations, 1, false, true);
         const MgRun two = solveMg(s, 1e-9, true, rotations, 2, false, true);
@@ -483,20 +491,9 @@ TEST_CASE("multigrid: smoothed aggregation gives the same bits on 1 and 2 thread
 
 TEST_CASE("multigrid: a fully pinned aggregate and plane filters keep the V-cycle SPD",
           "[multigrid]") {
-    // Pin a whole block of the sheet (aggregates with no free direction: dead coarse unknowns)
-    // and put every other vertex of a patch on a plane: PCG must still converge to LDLᵀ's answer.
-    ClothSystem s = makeClothSystem(20, 1.0 / 24.0, true, true);
-    for (int j = 5; j < 10; ++j)
-        for (int i = 5; i < 10; ++i) s.c.kind[j * 20 + i] = 1;
-    const Vec3 nrm = Vec3(0.3, 0.1, 1.0).normalized();
-    for (int j = 12; j < 18; ++j)
-        for (int i = 2; i < 18; i += 2) {
-            s.c.kind[j * 20 + i] = 2;
-            vec3At(s.c.normal.data(), j * 20 + i) = nrm;
-        }
-    FilteredSolver direct;
-    VecX ref = VecX::Zero(s.b.size());
-    REQUIRE(direct.solve(s.A, s.c, s.b, ref, LinearSolverKind::Direct, 0.0, 0).converged);
+    // A pinned block and plane filters (blockAndPlanes): PCG must still converge to LDLᵀ's answer.
+    VecX ref;
+    const ClothSystem s = blockAndPlanes(20, 12, 18, 18, ref);
     for (bool rotations : {false, true}) {
         const MgRun mg = solveMg(s, 1e-9, true, rotations);
         REQUIRE(mg.converged);
