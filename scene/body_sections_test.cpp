@@ -297,7 +297,7 @@ TEST_CASE("scene: [solver] stretch_limit is 0 (none, the default) or at least 1"
                                 "least 1") != std::string::npos);
 }
 
-TEST_CASE("scene: [solver] rotation_projection is off, contact (the default) or always",
+TEST_CASE("scene: [solver] rotation_projection is off, contact or always (the default)",
           "[scene]") {
     TempDir dir;
     const auto with = [&](const std::string& value) {
@@ -311,7 +311,7 @@ TEST_CASE("scene: [solver] rotation_projection is off, contact (the default) or 
         REQUIRE(l.ok);
         return l.scene.solver.rotationProjection;
     };
-    CHECK(mode("") == RotationProjection::Contact);
+    CHECK(mode("") == RotationProjection::Always);
     CHECK(mode("\"contact\"") == RotationProjection::Contact);
     CHECK(mode("\"off\"") == RotationProjection::Off);
     CHECK(mode("false") == RotationProjection::Off);

@@ -109,7 +109,7 @@ struct SolverSection {
     bool growBack = solver::WorldSettings{}.growBack;
     bool strainLimit = false;
     // When the length a linearised step's rotations add is projected out of every body's edges
-    // (solver::StepOptions::rotationProjection): "off", "contact" (default) or "always".
+    // (solver::StepOptions::rotationProjection): "off", "contact" or "always" (default).
     solver::RotationProjection rotationProjection = solver::StepOptions{}.rotationProjection;
     // Strain limit of every body's edges (× rest; 0: none; solver::StepOptions::stretchLimit).
     double stretchLimit = solver::StepOptions{}.stretchLimit;

@@ -32,19 +32,20 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     VecX x = x0 + h * (v0 + dv) + y;
     const auto at = [](const VecX& v, int i) { return Vec3(v.segment<3>(3 * i)); };
     // Targets from the linearised end state, and how many edges are beyond them.
-    std::vector<double> target(edges.size());
+    std::vector<double> target(edges.size()), len(edges.size()); // len: |x_b − x_a| at x
     int beyond = 0;
     double worst = 0.0;
     for (size_t e = 0; e < edges.size(); ++e) {
         const auto [a, b] = edges[e];
         const Vec3 d0 = at(x0, b) - at(x0, a), d1 = at(x, b) - at(x, a);
         const double l0 = d0.norm();
+        len[e] = d1.norm();
         target[e] = !rotations ? INFINITY : l0 > 0.0 ? std::max(rest[e], d0.dot(d1) / l0) : rest[e];
         // Below the cap by the tolerance: an edge is left alone within it of its target.
         if (stretchLimit > 0.0)
             target[e] = std::min(target[e], (stretchLimit - tolerance) * rest[e]);
         if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
-        const double excess = (d1.norm() - target[e]) / rest[e];
+        const double excess = (len[e] - target[e]) / rest[e];
         worst = std::max(worst, excess);
         if (excess > tolerance) ++beyond;
     }
@@ -68,24 +69,35 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         }
         return wOf[i];
     };
-    // The merit over every edge (a move may lengthen an edge that was not active).
-    const auto merit = [&](const VecX& p) {
-        double f = 0.0;
-        for (size_t e = 0; e < edges.size(); ++e) {
-            if (!(rest[e] > 0.0)) continue;
-            const auto [a, b] = edges[e];
-            const double ex = (at(p, b) - at(p, a)).norm() - target[e];
-            if (ex > 0.0) f += ex * ex;
-        }
-        return f;
+    // The merit Σ max(C, 0)² over every edge (a move may lengthen an edge that was not active),
+    // tracked by its change: a move of some vertices changes only the edges incident to them
+    // (incidence in CSR, built once a call), so each trial of the line search costs the moved
+    // vertices' edges, not a pass over the mesh.
+    const auto penalty = [&](size_t e, double l) {
+        const double ex = l - target[e];
+        return rest[e] > 0.0 && ex > 0.0 ? ex * ex : 0.0;
     };
+    std::vector<int> incStart(n + 1, 0), incEdges(2 * edges.size());
+    for (const auto& e : edges) {
+        ++incStart[static_cast<size_t>(e[0]) + 1];
+        ++incStart[static_cast<size_t>(e[1]) + 1];
+    }
+    for (size_t i = 0; i < n; ++i) incStart[i + 1] += incStart[i];
+    {
+        std::vector<int> fill(incStart.begin(), incStart.end() - 1);
+        for (size_t e = 0; e < edges.size(); ++e)
+            for (int v : edges[e])
+                incEdges[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(e);
+    }
+    std::vector<int> touched; // edges incident to the moved vertices, each once
+    std::vector<uint8_t> seen(edges.size(), 0);
+    std::vector<double> trialLen; // their lengths at the trial positions
     std::vector<int> slot(n, -1), verts;
     std::vector<Mat3> w;
 
     std::vector<int> active;
     std::vector<Vec3> dir, u;
     std::vector<double> c, lambda, r, z, p, q, diag;
-    VecX trial;
     const int maxIterations = stretchLimit > 0.0 ? kMaxLimitIterations : kMaxIterations;
     for (int it = 0; it < maxIterations; ++it) {
         active.clear();
@@ -95,13 +107,11 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         verts.clear();
         w.clear();
         for (size_t e = 0; e < edges.size(); ++e) {
+            const double excess = len[e] - target[e];
+            if (!(excess > tolerance * rest[e]) || !(len[e] > 0.0) || !(rest[e] > 0.0)) continue;
             const auto [a, b] = edges[e];
-            const Vec3 d = at(x, b) - at(x, a);
-            const double len = d.norm();
-            const double excess = len - target[e];
-            if (!(excess > tolerance * rest[e]) || !(len > 0.0) || !(rest[e] > 0.0)) continue;
             active.push_back(static_cast<int>(e));
-            dir.push_back(d / len);
+            dir.push_back((at(x, b) - at(x, a)) / len[e]);
             c.push_back(excess);
             for (int v : edges[e])
                 if (slot[static_cast<size_t>(v)] < 0) {
@@ -180,22 +190,44 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
             rz = rzNew;
             for (size_t k = 0; k < m; ++k) p[k] = z[k] + beta * p[k];
         }
-        // The step −W Jᵀ λ on the vertices of the active edges, halved until the merit falls.
+        // The step −W Jᵀ λ on the vertices of the active edges, halved until the merit falls:
+        // its change over the edges incident to them, Σ φ_e(trial) − φ_e(x).
         spread(lambda);
-        const double f0 = merit(x);
+        touched.clear();
+        for (int v : verts)
+            for (int k = incStart[static_cast<size_t>(v)]; k < incStart[static_cast<size_t>(v) + 1];
+                 ++k) {
+                const int e = incEdges[static_cast<size_t>(k)];
+                if (!seen[static_cast<size_t>(e)]) {
+                    seen[static_cast<size_t>(e)] = 1;
+                    touched.push_back(e);
+                }
+            }
+        for (int e : touched) seen[static_cast<size_t>(e)] = 0;
+        trialLen.resize(touched.size());
+        const auto trialAt = [&](int v, double s) {
+            const int k = slot[static_cast<size_t>(v)];
+            return k >= 0 ? Vec3(at(x, v) - s * u[static_cast<size_t>(k)]) : at(x, v);
+        };
         double s = 1.0;
         bool lowered = false;
-        trial = x;
         for (int cut = 0; cut <= kMaxCuts; ++cut, s *= 0.5) {
-            for (size_t k = 0; k < verts.size(); ++k)
-                trial.segment<3>(3 * verts[k]) = at(x, verts[k]) - s * u[k];
-            if (merit(trial) < f0) {
+            double change = 0.0;
+            for (size_t k = 0; k < touched.size(); ++k) {
+                const size_t e = static_cast<size_t>(touched[k]);
+                trialLen[k] = (trialAt(edges[e][1], s) - trialAt(edges[e][0], s)).norm();
+                change += penalty(e, trialLen[k]) - penalty(e, len[e]);
+            }
+            if (change < 0.0) {
                 lowered = true;
                 break;
             }
         }
         if (!lowered) break;
-        for (int v : verts) x.segment<3>(3 * v) = trial.segment<3>(3 * v);
+        for (size_t k = 0; k < verts.size(); ++k)
+            x.segment<3>(3 * verts[k]) = at(x, verts[k]) - s * u[k];
+        for (size_t k = 0; k < touched.size(); ++k)
+            len[static_cast<size_t>(touched[k])] = trialLen[k];
     }
     worst = 0.0;
     for (size_t e = 0; e < edges.size(); ++e) {

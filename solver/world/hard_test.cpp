@@ -189,22 +189,23 @@ TEST_CASE("hard: gossamer flag 3 degrees off edge-on takes one substep per frame
 }
 
 TEST_CASE("hard: the gossamer flag at one substep a frame stays within a stretch limit", "[hard]") {
-    // The same flag with [solver] stretch_limit = 1.5: no frame ends with an edge beyond it,
-    // where without the limit the flag passes it (bench/README.md: 2.9 at 20 m/s).
-    for (double U : {20.0, 40.0}) {
+    // The same flag with a [solver] stretch_limit it passes without one (with the rotation
+    // projection, the default, 1.46 at 20 m/s and 1.90 at 40; 2.9 at 20 m/s without either,
+    // bench/README.md): no frame ends with an edge beyond it.
+    for (const auto& [U, cap] : {std::pair{20.0, 1.3}, std::pair{40.0, 1.5}}) {
         FlagSetup s = offEdgeOn(U);
         const FlagRun free = runFlag(s);
-        s.stretchLimit = 1.5;
+        s.stretchLimit = cap;
         const FlagRun limited = runFlag(s);
         INFO("U " << U << " stretch without the limit " << free.maxStretch << ", with it "
                   << limited.maxStretch << " (speed " << limited.maxSpeed << ", rejected "
                   << limited.rejected << ")");
-        CHECK(free.maxStretch > 1.5);
+        CHECK(free.maxStretch > cap);
         CHECK_FALSE(limited.failed);
         CHECK(limited.finite);
         CHECK(limited.rejected == 0);
         CHECK(limited.maxSpeed < 2.0 * U);
-        CHECK(limited.maxStretch <= 1.5);
+        CHECK(limited.maxStretch <= cap);
     }
 }
 
