@@ -229,12 +229,9 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         for (size_t k = 0; k < touched.size(); ++k)
             len[static_cast<size_t>(touched[k])] = trialLen[k];
     }
-    worst = 0.0;
-    for (size_t e = 0; e < edges.size(); ++e) {
-        const auto [a, b] = edges[e];
-        if (rest[e] > 0.0)
-            worst = std::max(worst, ((at(x, b) - at(x, a)).norm() - target[e]) / rest[e]);
-    }
+    worst = 0.0; // (len holds every edge's length at x: the accepted moves updated theirs)
+    for (size_t e = 0; e < edges.size(); ++e)
+        if (rest[e] > 0.0) worst = std::max(worst, (len[e] - target[e]) / rest[e]);
     stats.excessAfter = worst;
     if (!x.allFinite()) return stats; // Δv left as the linearised step's
     for (size_t v = 0; v < n; ++v)
