@@ -83,17 +83,33 @@ bool FileWatcher::addWatch(const std::string& dir) {
     return true;
 }
 
-void FileWatcher::rescan() {
+void FileWatcher::rescan(std::set<std::string>* appeared) {
+    const std::set<std::string> wasMissing = std::move(mMissing);
     mMissing.clear();
     for (const std::string& dir : mWanted) {
         std::error_code ec;
-        if (fs::is_directory(dir, ec) && addWatch(dir)) continue;
+        if (fs::is_directory(dir, ec) && addWatch(dir)) {
+            if (appeared && wasMissing.count(dir)) listMatches(dir, *appeared);
+            continue;
+        }
         mMissing.insert(dir);
         // The nearest existing parent (the root at worst) waits for the next folder on the way.
         for (fs::path p = fs::path(dir).parent_path();; p = p.parent_path()) {
             if (fs::is_directory(p, ec) && addWatch(p.string())) break;
             if (p == p.parent_path()) break;
         }
+    }
+}
+
+void FileWatcher::listMatches(const std::string& dir, std::set<std::string>& out) const {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string path = it->path().lexically_normal().string();
+        const std::string name = it->path().filename().string();
+        bool match = mFiles.count(path) > 0;
+        for (const auto& [folder, pattern] : mPatterns)
+            match = match || (folder == dir && std::regex_match(name, pattern));
+        if (match) out.insert(path);
     }
 }
 
@@ -201,7 +217,7 @@ void FileWatcher::run() {
                             again = true;
                         }
             }
-            if (again) rescan();
+            if (again) rescan(&pending);
         }
     }
 }

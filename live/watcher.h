@@ -2,8 +2,9 @@
 // often write a new file and rename it over the old one), and a change to any watched name is
 // reported once the folder has been quiet for a short settle time. A folder that does not exist
 // yet is waited for at its nearest existing parent: when it appears (or any folder on the way
-// to it), it is watched from then on and reported as a change, so a scene that named a missing
-// folder reloads once the folder and its files are there.
+// to it), it is watched from then on and reported as a change, together with the files in it
+// that match (written before its watch could be added), so a scene that named a missing folder
+// reloads once the folder and its files are there.
 #pragma once
 
 #include <atomic>
@@ -41,9 +42,12 @@ public:
 private:
     void run();
     // Adds a watch on each wanted folder that exists, else on its nearest existing parent.
-    // Called with mMutex held.
-    void rescan();
+    // Files already in a folder that was missing and is now watched, matching a watched name or
+    // pattern, go into `appeared` (when given). Called with mMutex held.
+    void rescan(std::set<std::string>* appeared = nullptr);
     bool addWatch(const std::string& dir);
+    // The files in `dir` that match a watched name or pattern (called with mMutex held).
+    void listMatches(const std::string& dir, std::set<std::string>& out) const;
 
     std::function<void(const std::set<std::string>&)> mOnChange;
     int mSettleMs;
