@@ -11,6 +11,7 @@
 # --responses: the response to a substep in trouble instead (issue 26, third pass), each
 # response a name and `[solver]` settings, e.g.
 #   --responses 'repeat16=retry_repeat=true,retry_newton=16;halve=retry_newton=0,grow_back=true'
+# (a dotted key is any scene key: 'bounded=cloth.flag.aero_jacobian="bounded"')
 # per response: median frame wall (frames 4..), worst frame / median (wall and CG iterations:
 # the frame's summed CG iterations over the median frame's), max stretch over the run, Newton
 # retries, rejected substeps and the deepest halving, and — with --reference-substeps N — the
@@ -99,7 +100,8 @@ def responses_mode(args, tmp):
     responses = []
     for item in args.responses.split(";"):
         name, _, sets = item.partition("=")
-        responses.append((name, ["solver." + s for s in sets.split(",") if s]))
+        # A bare key is a [solver] one; a dotted one (cloth.flag.aero_jacobian=...) is taken as is.
+        responses.append((name, [s if "." in s.split("=")[0] else "solver." + s for s in sets.split(",") if s]))
     print("| res | response | median frame s | worst/median wall (frame) | worst/median CG its (frame) | max stretch | retries | Newton its | rejected | deepest halving | distance to ref (m) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for res in [int(x) for x in args.res.split(",")]:

@@ -96,8 +96,7 @@ std::string settingsJson(const scene::SimScene& sc,
                                                                                      : "true")
           << ", \"aero_model\": \""
           << (m.aeroModel == solver::AeroModel::Frozen ? "frozen" : "smooth-lift")
-          << "\", \"aero_jacobian\": \""
-          << (c.step.aeroJacobian == solver::AeroJacobian::Paper ? "paper" : "projected") << "\", "
+          << "\", \"aero_jacobian\": \"" << solver::aeroJacobianName(c.step.aeroJacobian) << "\", "
           << stepJson(c.step) << ", \"self_collision\": " << (c.collision.self ? "true" : "false")
           << ", \"thickness\": " << num(c.collision.thickness) << ", \"output\": \"" << c.output
           << "\"}";

@@ -468,11 +468,10 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
         if (choice(*n, "aero_model", {"frozen", "smooth-lift"}, v))
             c.material.aeroModel = v == "frozen" ? AeroModel::Frozen : AeroModel::SmoothLift;
     }
-    if (const toml::node* n = t.get("aero_jacobian")) {
-        std::string v;
-        if (choice(*n, "aero_jacobian", {"projected", "paper"}, v))
-            c.step.aeroJacobian = v == "paper" ? AeroJacobian::Paper : AeroJacobian::Projected;
-    }
+    if (const toml::node* n = t.get("aero_jacobian"))
+        named(*n, "aero_jacobian",
+              {AeroJacobian::Bounded, AeroJacobian::Projected, AeroJacobian::Paper},
+              aeroJacobianName, c.step.aeroJacobian);
     if (const toml::node* n = t.get("pins")) c.hasPins = pins(*n, what + " pins", c.pins);
     if (const toml::node* n = t.get("attach"))
         c.hasAttach = attach(*n, what + " attach", baseDir, true, c.attach, c.attachMesh);

@@ -10,6 +10,8 @@
 //                  + C_L (r n nᵀ + (s/r) n vᵀ − (2s/r) v nᵀ − (s²/r) I + (s²/r³) v vᵀ)]
 // Paper substitution (both models reduce to it with v ≈ s n):
 //   D = ½ρA s[(C_D − C_L) I + (C_D + C_L) n nᵀ]
+// Bounded (default) and Projected: the symmetric part of the exact Jacobian made PSD; see
+// aeroTriangle.
 #include "solver/bodies/aero.h"
 
 #include <algorithm>
@@ -141,6 +143,20 @@ Mat3 aeroTriangleAreaJacobian(const Vec3& vRel, const Vec3& areaNormal, double r
     return 0.5 * rho * (cd * sigma * vv + cl * lift);
 }
 
+const char* aeroJacobianName(AeroJacobian j) {
+    switch (j) {
+    case AeroJacobian::Bounded:
+        return "bounded";
+    case AeroJacobian::Projected:
+        return "projected";
+    case AeroJacobian::Paper:
+        return "paper";
+    case AeroJacobian::None:
+        break;
+    }
+    return "none";
+}
+
 AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, double cl,
                         double cd, AeroModel model, AeroJacobian jacobian) {
     AeroResult out;
@@ -169,13 +185,25 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
         out.damping = k * s * (iso * Mat3::Identity() + (cd + cl) * n * n.transpose());
         break;
     }
+    case AeroJacobian::Bounded:
     case AeroJacobian::Projected: {
-        // projectPsdInPlane(aeroTriangleExactJacobian(..), n, v) with the symmetric part of the
-        // exact Jacobian written out in the basis (n, e, b), v = s n + q e, r² = s² + q²:
-        //   frozen:      M = k [[2 C_D s, (C_D + C_L) q/2], [·, (C_D − C_L) s]],  c = k (C_D − C_L) s
-        //   smooth-lift: M = k [[2 C_D s + C_L q⁴/r³, C_D q/2 + C_L s q (s² − q²)/(2r³)],
-        //                       [·, C_D s − C_L s⁴/r³]],                    c = k (C_D s − C_L s²/r)
+        // The symmetric part of the exact Jacobian written out in the basis (n, e, b),
+        // v = s n + q e, r² = s² + q², as M = [[a11, a12], [a12, a22]] on (n, e) and c on b:
+        //   frozen:      M = k [[2 C_D s, (C_D + C_L) q/2], [·, (C_D − C_L) s]],  c = k (C_D − C_L)
+        //   s smooth-lift: M = k [[2 C_D s + C_L q⁴/r³, C_D q/2 + C_L s q (s² − q²)/(2r³)],
+        //                       [·, C_D s − C_L s⁴/r³]],                    c = k (C_D s − C_L
+        //                       s²/r)
         // (smooth-lift in the bounded ratios σ = s/r, κ = q/r: q⁴/r³ = q κ³, s⁴/r³ = s σ³, ...).
+        // Projected: projectPsdInPlane(aeroTriangleExactJacobian(..), n, v) in closed form.
+        // Bounded: the coupling a12 moved onto the diagonal, diag(a11 + |a12|, a22 + |a12|) ⪰ M
+        // (the difference |a12| [[1, −sgn], [−sgn, 1]] is PSD), then clamped as Projected is.
+        // Where M is indefinite — a flag streaming in the wind, q ≫ s: a12 ≈ k(C_D + C_L)q/2
+        // against diagonals ∝ s — Projected keeps a rank-one damping along one diagonal of
+        // (n, e) and none along the other, so a normal push (lift, a gust) moves the cloth
+        // along the flow, in-plane, undamped; neighbouring triangles pushed differently then
+        // stretch the edges along the wind (the wind-onset flag at 256²: 2.7× after the onset;
+        // Bounded 1.47×, bench/README.md). Bounded damps n and e each on its own; edge-on
+        // (s = 0) it keeps the normal damping k(C_D + C_L)q/2 that makes Projected stable.
         double q;
         const double r = std::sqrt(r2);
         const Vec3 e = inPlaneDirection(n, vRel, r, q);
@@ -186,16 +214,24 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
         // default C_L = 0.3, C_D = 1 gives 0.1 against 0.65: left out, the solve stays symmetric).
         const double cw = model == AeroModel::Frozen ? cd - 3.0 * cl : cd - 3.0 * cl * (s / r);
         if (std::abs(cw) > kSkewGate * (cd + cl)) out.skewAxis = 0.5 * k * cw * n.cross(vRel);
+        double a11, a12, a22, c;
         if (model == AeroModel::Frozen) {
-            const double iso = k * (cd - cl) * s;
-            out.damping = projectPlane(2.0 * k * cd * s, 0.5 * k * (cd + cl) * q, iso, iso, n, e);
+            a11 = 2.0 * k * cd * s;
+            a12 = 0.5 * k * (cd + cl) * q;
+            a22 = c = k * (cd - cl) * s;
         } else {
             const double sig = s / r, kap = q / r;
-            out.damping = projectPlane(k * (2.0 * cd * s + cl * q * kap * kap * kap),
-                                       k * (0.5 * cd * q + 0.5 * cl * s * kap * (sig * sig - kap * kap)),
-                                       k * (cd * s - cl * s * sig * sig * sig), k * (cd * s - cl * s * sig),
-                                       n, e);
+            a11 = k * (2.0 * cd * s + cl * q * kap * kap * kap);
+            a12 = k * (0.5 * cd * q + 0.5 * cl * s * kap * (sig * sig - kap * kap));
+            a22 = k * (cd * s - cl * s * sig * sig * sig);
+            c = k * (cd * s - cl * s * sig);
         }
+        if (jacobian == AeroJacobian::Bounded) {
+            a11 += std::abs(a12);
+            a22 += std::abs(a12);
+            a12 = 0.0;
+        }
+        out.damping = projectPlane(a11, a12, a22, c, n, e);
         break;
     }
     }

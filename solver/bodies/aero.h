@@ -15,10 +15,15 @@ enum class AeroModel {
 
 // How the velocity Jacobian is linearised for the implicit solve.
 enum class AeroJacobian {
-    Projected, // symmetrised exact ∂F/∂v with negative eigenvalues clamped (default: stable)
+    Bounded, // symmetrised exact ∂F/∂v, its normal–in-plane coupling moved onto the diagonal
+             // (an upper bound), negative parts clamped (default: stable, no coupling mode)
+    Projected, // symmetrised exact ∂F/∂v with negative eigenvalues clamped (stable)
     Paper,     // the paper's substitution v ≈ (v·n)n after differentiation
     None,      // aerodynamics applied explicitly (for comparisons only: unstable in strong wind)
 };
+
+// The scene's name of each (`aero_jacobian`): "bounded", "projected", "paper", "none".
+const char* aeroJacobianName(AeroJacobian j);
 
 // Force on an element from the air and its damping matrix D (symmetric positive
 // semi-definite, N·s/m): with v = v_wind − v_element, ∂F/∂v_element ≈ −D.

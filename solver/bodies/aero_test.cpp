@@ -66,7 +66,8 @@ TEST_CASE("aero: invariants — winding, F·v ≥ 0, broadside, zero area, zero 
         const Vec3 an = 0.05 * Vec3(u(rng), u(rng), u(rng));
         const double cl = 0.5 * (1 + u(rng)), cd = 0.5 * (1 + u(rng)) + 0.2;
         for (AeroModel model : {AeroModel::Frozen, AeroModel::SmoothLift})
-            for (AeroJacobian jac : {AeroJacobian::Projected, AeroJacobian::Paper}) {
+            for (AeroJacobian jac :
+                 {AeroJacobian::Bounded, AeroJacobian::Projected, AeroJacobian::Paper}) {
                 const AeroResult a = aeroTriangle(v, an, kRho, cl, cd, model, jac);
                 const AeroResult b = aeroTriangle(v, -an, kRho, cl, cd, model, jac);
                 CHECK((a.force - b.force).norm() <= 1e-12 * (1 + a.force.norm()));
@@ -177,6 +178,60 @@ TEST_CASE("aero: damping matrices are symmetric positive semi-definite", "[aero]
             CHECK(q.clamped == (cd < cl && v.squaredNorm() > 0));
         }
     }
+}
+
+TEST_CASE("aero: the bounded damping is PSD, diagonal in (n, e, n × e) and above the exact one",
+          "[aero]") {
+    // D_bounded ⪰ sym(∂F/∂v): the exact Jacobian's symmetric part with its normal–in-plane
+    // coupling a12 moved onto both diagonals (diag(|a12|, |a12|) − a12(neᵀ + enᵀ) is PSD), so
+    // D − sym(J) has no negative eigenvalue; D is itself PSD and, unlike the projected damping
+    // (also above sym(J), rank one in the (n, e) plane where sym(J) is indefinite there),
+    // couples none of n, e = the in-plane direction of v, and b = n × e.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int k = 0; k < 500; ++k) {
+        Vec3 v = 20.0 * Vec3(u(rng), u(rng), u(rng));
+        const Vec3 an = 0.02 * Vec3(u(rng), u(rng), u(rng));
+        Vec3 n = an.normalized();
+        if (k % 5 == 0) v -= v.dot(n) * n; // exactly edge-on
+        if (k % 7 == 0) v = 9.0 * n;       // broadside: no in-plane direction
+        if (n.dot(v) < 0) n = -n;
+        const double cl = 0.8 * (1 + u(rng)), cd = 0.8 * (1 + u(rng));
+        for (AeroModel model : {AeroModel::Frozen, AeroModel::SmoothLift}) {
+            const AeroResult d = aeroTriangle(v, an, kRho, cl, cd, model, AeroJacobian::Bounded);
+            const Mat3 J = aeroTriangleExactJacobian(v, an, kRho, cl, cd, model);
+            const Mat3 sym = 0.5 * (J + J.transpose());
+            const double tol = 1e-10 * (1 + J.norm());
+            CHECK((d.damping - d.damping.transpose()).norm() <= tol);
+            CHECK(minEigen(d.damping) >= -tol);
+            CHECK(minEigen(d.damping - sym) >= -tol);
+            const Vec3 inPlane = v - v.dot(n) * n;
+            if (inPlane.norm() > 1e-9 * v.norm()) {
+                const Vec3 e = inPlane.normalized(), b = n.cross(e);
+                CHECK(std::abs(e.dot(d.damping * n)) <= tol);
+                CHECK(std::abs(b.dot(d.damping * n)) <= tol);
+                CHECK(std::abs(b.dot(d.damping * e)) <= tol);
+            } else { // no coupling to move: the projection of the exact Jacobian
+                const AeroResult p =
+                    aeroTriangle(v, an, kRho, cl, cd, model, AeroJacobian::Projected);
+                CHECK((d.damping - p.damping).norm() <= tol);
+            }
+            // The same force and skew part as the projected linearisation.
+            const AeroResult p = aeroTriangle(v, an, kRho, cl, cd, model, AeroJacobian::Projected);
+            CHECK(d.force == p.force);
+            CHECK(d.skewAxis == p.skewAxis);
+        }
+    }
+    // Edge-on (frozen, C_L = 0.3, C_D = 1): sym(J) = ½ρA (C_D + C_L)/2 (v nᵀ + n vᵀ); the bound
+    // damps the normal and the flow direction each by ½ρA (C_D + C_L)|v|/2 — the projected
+    // damping's one eigenvalue — and the third direction not at all.
+    const Vec3 v(20.0, 0.0, 0.0);
+    const AeroResult d = aeroTriangle(v, areaNormal(0.01, false), kRho, 0.3, 1.0, AeroModel::Frozen,
+                                      AeroJacobian::Bounded);
+    const double want = 0.5 * kRho * 0.01 * 1.3 * 20.0 / 2.0;
+    CHECK(d.damping(2, 2) == Approx(want));
+    CHECK(d.damping(0, 0) == Approx(want));
+    CHECK(d.damping(1, 1) == Approx(0.0).margin(1e-15));
 }
 
 TEST_CASE("aero: edge-on, the paper's Jacobian vanishes but the projected one does not", "[aero]") {

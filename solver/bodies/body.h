@@ -70,7 +70,7 @@ const char* rotationProjectionName(RotationProjection r); // "off", "contact", "
 
 // Numerical settings of a body's substep.
 struct StepOptions {
-    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    AeroJacobian aeroJacobian = AeroJacobian::Bounded;
     LinearSolverKind linearSolver = LinearSolverKind::Pcg;
     Preconditioner preconditioner =
         Preconditioner::Multigrid; // of PCG (multigrid.h; measured faster, bench/README.md)
@@ -232,7 +232,7 @@ struct ForceInput {
     const double* wind = nullptr; // per vertex, null when the body feels no wind
     double t = 0.0, h = 0.0;
     double airDensity = 1.225;
-    AeroJacobian aeroJacobian = AeroJacobian::Projected;
+    AeroJacobian aeroJacobian = AeroJacobian::Bounded;
     bool aeroPosition = false; // also the orientation part of ∂F/∂x (AeroOrientation)
 };
 struct ForceOutput {

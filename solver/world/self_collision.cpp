@@ -11,8 +11,10 @@
 //      (Provot 1997; Harmon et al. 2008): x₁ = x₀ + D + ω × (x₀ − c). That map is affine with
 //      linear part I + t[ω]× at every t, whose singular values are ≥ 1, so no distance inside a
 //      zone shrinks during the step: a zone never hits itself, and zones only grow (union-find)
-//      until nothing hits. Last resort: hold the zones' free vertices at x₀ (the start state,
-//      which had no crossings).
+//      until nothing hits. A zone with pins or attachments keeps their motion and gives its free
+//      vertices the rigid motion fitted to theirs; where they do not move together (a collar on
+//      a turning body) only its pairs with a held vertex can still meet. Last resort: hold the
+//      zones' free vertices at x₀ (the start state, which had no crossings).
 // A pair's weights α (Σ α = 0) give its relative position r = Σ α_k x_k; a correction of r by
 // Δ n moves vertex k by λ α_k w_k n, w = 1/m (0 for pins and attachments), λ = Δ / Σ α_k² w_k:
 // the impulse that conserves momentum.
@@ -490,60 +492,63 @@ bool SelfCollision::rigidZone(const std::vector<int>& members) const {
     return true;
 }
 
+// The motion x₁ = x₀ + D + ω_d × (x₀ − c), v = V + ω_v × (x₀ − c) with the linear and angular
+// momentum of `members`' displacements and velocities (weights `weight(i)`): D = Σ w d / Σ w,
+// ω = I⁻¹ Σ w r × (d − D), r = x₀ − c, I = Σ w (|r|² I − r rᵀ). Its linear part I + t[ω_d]× has
+// singular values ≥ 1 at every t of the step, so no distance it carries shrinks on the way.
+struct ZoneMotion {
+    Vec3 c = Vec3::Zero(), D = Vec3::Zero(), V = Vec3::Zero(), wd = Vec3::Zero(), wv = Vec3::Zero();
+    template <class Weight>
+    ZoneMotion(const std::vector<int>& members, const std::vector<double>& x0,
+               const std::vector<double>& d0, const std::vector<double>& v0, Weight weight) {
+        double mass = 0.0;
+        for (int i : members) {
+            const double w = weight(i);
+            mass += w;
+            c += w * Vec3(vec3At(x0.data(), i));
+            D += w * Vec3(vec3At(d0.data(), i));
+            V += w * Vec3(vec3At(v0.data(), i));
+        }
+        c /= mass;
+        D /= mass;
+        V /= mass;
+        Mat3 inertia = Mat3::Zero();
+        Vec3 Ld = Vec3::Zero(), Lv = Vec3::Zero();
+        for (int i : members) {
+            const double w = weight(i);
+            const Vec3 r = Vec3(vec3At(x0.data(), i)) - c;
+            inertia += w * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+            Ld += w * r.cross(Vec3(vec3At(d0.data(), i)) - D);
+            Lv += w * r.cross(Vec3(vec3At(v0.data(), i)) - V);
+        }
+        // A zone on a line (or a point) has no inertia about it: regularise so ω stays finite.
+        inertia += (1e-12 * inertia.trace() + 1e-300) * Mat3::Identity();
+        const Eigen::LDLT<Mat3> ldlt(inertia);
+        wd = ldlt.solve(Ld);
+        wv = ldlt.solve(Lv);
+    }
+    void apply(int i, const std::vector<double>& x0, std::vector<double>& x1,
+               std::vector<double>& v) const {
+        const Vec3 r = Vec3(vec3At(x0.data(), i)) - c;
+        vec3At(x1.data(), i) = Vec3(vec3At(x0.data(), i)) + D + wd.cross(r);
+        vec3At(v.data(), i) = V + wv.cross(r);
+    }
+};
+
 void SelfCollision::applyZone(const std::vector<int>& members) {
-    // Pins and attachments in the zone: their common displacement for all when they share one
-    // (static pins, or a translation: still affine); otherwise the zone follows their mean
-    // (no longer rigid: counted as unresolved when it hits again).
+    // Pins and attachments in the zone (their own motion kept): the free vertices take the
+    // rigid motion fitted to theirs — their common displacement when they share one (static
+    // pins, or a translation: the zone is then rigid), else the momentum fit of their
+    // displacements (a collar sewn to a turning body: the zone turns with it; no longer rigid,
+    // its pairs are tested whole). Without them, the zone's own linear and angular momentum.
     std::vector<int> fixed;
     for (int i : members)
         if (mInvMass[i] == 0.0) fixed.push_back(i);
-    const auto d0 = [&](int i) { return Vec3(vec3At(mD0.data(), i)); };
-    const auto v0 = [&](int i) { return Vec3(vec3At(mV0.data(), i)); };
-    if (!fixed.empty()) {
-        Vec3 d = Vec3::Zero(), v = Vec3::Zero();
-        for (int i : fixed) {
-            d += d0(i);
-            v += v0(i);
-        }
-        d /= static_cast<double>(fixed.size());
-        v /= static_cast<double>(fixed.size());
-        for (int i : members) {
-            if (mInvMass[i] == 0.0) continue;
-            vec3At(mX1.data(), i) = vec3At(mX0.data(), i) + d;
-            vec3At(mV.data(), i) = v;
-        }
-        return;
-    }
-    // The rigid motion with the zone's linear and angular momentum (of displacement and of
-    // velocity): D = Σ m d / Σ m, ω = I⁻¹ Σ m r × (d − D), r = x₀ − c.
-    double mass = 0.0;
-    Vec3 c = Vec3::Zero(), D = Vec3::Zero(), V = Vec3::Zero();
-    for (int i : members) {
-        mass += mMass[i];
-        c += mMass[i] * Vec3(vec3At(mX0.data(), i));
-        D += mMass[i] * d0(i);
-        V += mMass[i] * v0(i);
-    }
-    c /= mass;
-    D /= mass;
-    V /= mass;
-    Mat3 inertia = Mat3::Zero();
-    Vec3 Ld = Vec3::Zero(), Lv = Vec3::Zero();
-    for (int i : members) {
-        const Vec3 r = Vec3(vec3At(mX0.data(), i)) - c;
-        inertia += mMass[i] * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
-        Ld += mMass[i] * r.cross(d0(i) - D);
-        Lv += mMass[i] * r.cross(v0(i) - V);
-    }
-    // A zone on a line (or a point) has no inertia about it: regularise so ω stays finite.
-    inertia += (1e-12 * inertia.trace() + 1e-300) * Mat3::Identity();
-    const Eigen::LDLT<Mat3> ldlt(inertia);
-    const Vec3 wd = ldlt.solve(Ld), wv = ldlt.solve(Lv);
-    for (int i : members) {
-        const Vec3 r = Vec3(vec3At(mX0.data(), i)) - c;
-        vec3At(mX1.data(), i) = Vec3(vec3At(mX0.data(), i)) + D + wd.cross(r);
-        vec3At(mV.data(), i) = V + wv.cross(r);
-    }
+    const ZoneMotion motion =
+        fixed.empty() ? ZoneMotion(members, mX0, mD0, mV0, [&](int i) { return mMass[i]; })
+                      : ZoneMotion(fixed, mX0, mD0, mV0, [](int) { return 1.0; });
+    for (int i : members)
+        if (mInvMass[i] != 0.0) motion.apply(i, mX0, mX1, mV);
 }
 
 void SelfCollision::impactZones(std::vector<Pair>& hits) {
@@ -569,16 +574,18 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
         for (const auto& z : zones)
             if (!z.empty()) {
                 applyZone(z);
-                // Pins in a zone that do not move together make it non-rigid: test it whole.
-                if (rigidZone(z))
-                    for (int i : z) zoneOf[i] = z.front();
+                // Its free vertices move by one affine map whose distances do not shrink: their
+                // pairs are skipped. So are the held ones' when they move together (the zone is
+                // rigid); otherwise each pair with a held vertex is tested.
+                const bool rigid = rigidZone(z);
+                for (int i : z)
+                    if (rigid || mInvMass[i] != 0.0) zoneOf[i] = z.front();
             }
         const std::vector<uint8_t> dirty = dirtySince(before);
         ccdRound(false, &hits, &zoneOf, &dirty);
     }
     long long zoneCount = 0;
     for (uint8_t z : inZone) zoneCount += z;
-    mStats.zoneVertices += zoneCount;
     // Last resort: free vertices of the zones and of the pairs still hitting stay at x₀.
     for (int r = 0; r < 16 && !hits.empty(); ++r) {
         for (const Pair& p : hits)

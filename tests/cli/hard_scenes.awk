@@ -113,7 +113,7 @@ BEGIN {
                 num(logu(0.001, 1)), param(10, 10000, dur), num(logu(1, 1000)), num(logu(1e-6, 1e-2)),
                 num(uni(0, 0.05)) > f
             model = "frozen"; if (rnd() < 0.5) model = "smooth-lift"
-            jac = "projected"; if (rnd() < 0.3) jac = "paper"
+            r = rnd(); jac = r < 0.3 ? "paper" : r < 0.5 ? "projected" : "bounded"
             lin = "pcg"; if (rnd() < 0.3) lin = "direct"
             fmt = "obj"; if (rnd() < 0.5) fmt = "ply"
             printf "lift = %s\ndrag = %s\naero_model = \"%s\"\naero_jacobian = \"%s\"\nlinear_solver = \"%s\"\noutput = \"%s\"\n",
