@@ -280,6 +280,22 @@ TEST_CASE("self-collision: an interval the pass stretched is solved again with i
     CHECK(pass.intersecting == 0);
 }
 
+namespace {
+
+// The pass with no CCD rounds (straight to the impact zones) on two cloths from a0 and b0, at
+// ξ = 3 mm.
+SelfCollisionStats failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, Cloth& b,
+                                const TriMesh& bm, const VecX& b0) {
+    SelfCollisionSettings settings;
+    settings.ccdRounds = 0;
+    SelfCollision sc(settings);
+    sc.addBody(a, am.triangles, a0, 0.003);
+    sc.addBody(b, bm.triangles, b0, 0.003);
+    return sc.resolve({a0, b0});
+}
+
+} // namespace
+
 TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self]") {
     // Two single triangles; the upper one's step goes straight through the lower one. With no
     // CCD rounds the pass goes to the impact zones at once.
@@ -313,12 +329,7 @@ TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self
         return p;
     };
     const Vec3 before = momentum(a1 - a0, b1 - b0);
-    SelfCollisionSettings settings;
-    settings.ccdRounds = 0;
-    SelfCollision sc(settings);
-    sc.addBody(a, lower.triangles, a0, 0.003);
-    sc.addBody(b, upper.triangles, b0, 0.003);
-    const SelfCollisionStats st = sc.resolve({a0, b0});
+    const SelfCollisionStats st = failSafeOnly(a, lower, a0, b, upper, b0);
     CHECK(st.failSafeRuns == 1);
     CHECK(st.unresolved == 0);
     CHECK(st.frozenVertices == 0);
@@ -398,19 +409,14 @@ TEST_CASE("self-collision: an impact zone whose held vertices do not move togeth
     b.setPositions(b1);
     a.setVelocities(24.0 * (a1 - a0));
     b.setVelocities(24.0 * (b1 - b0));
-    SelfCollisionSettings settings;
-    settings.ccdRounds = 0;
-    SelfCollision sc(settings);
-    sc.addBody(a, lower.triangles, a0, 0.003);
-    sc.addBody(b, upper.triangles, b0, 0.003);
-    const SelfCollisionStats st = sc.resolve({a0, b0});
+    const SelfCollisionStats st = failSafeOnly(a, lower, a0, b, upper, b0);
     CHECK(st.failSafeRuns == 1);
     CHECK(st.unresolved == 0);
     CHECK(st.frozenVertices == 0);
     const VecX& A1 = a.positions();
     const VecX& B1 = b.positions();
-    CHECK((A1.head<6>() - a1.head<6>()).norm() ==
-          0.0); // the held corners where their motion takes them
+    // The held corners end where their motion takes them.
+    CHECK((A1.head<6>() - a1.head<6>()).norm() == 0.0);
     // The free vertices (the quad's back corners, the triangle): no distance shrank.
     std::vector<Vec3> f0 = {a0.segment<3>(6), a0.segment<3>(9)},
                       f1 = {A1.segment<3>(6), A1.segment<3>(9)};
