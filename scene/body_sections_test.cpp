@@ -168,6 +168,16 @@ TEST_CASE("scene: --set overrides the solver's keys by dotted path", "[scene]") 
     CHECK(l.scene.hairs[0].material.radius == 2e-4);
     CHECK(l.scene.wind.settings.fps == 30);
 
+    // Each aero_jacobian by its name; without the key, the default (bounded).
+    for (const AeroJacobian j :
+         {AeroJacobian::Bounded, AeroJacobian::Projected, AeroJacobian::Paper}) {
+        Loaded named = load(
+            dir, kCape, {std::string("cloth.cape.aero_jacobian=\"") + aeroJacobianName(j) + "\""});
+        REQUIRE(named.ok);
+        CHECK(named.scene.cloths[0].step.aeroJacobian == j);
+    }
+    CHECK(ClothSpec{}.step.aeroJacobian == AeroJacobian::Bounded);
+
     Loaded bad = load(dir, kCape, {"cloth.cloak.drag=0.8"});
     CHECK_FALSE(bad.ok);
     CHECK(bad.all().find("--set cloth.cloak.drag=0.8: error: the scene has no [[cloth]] named 'cloak'") != std::string::npos);
