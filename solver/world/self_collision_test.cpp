@@ -282,16 +282,24 @@ TEST_CASE("self-collision: an interval the pass stretched is solved again with i
 
 namespace {
 
-// The pass with no CCD rounds (straight to the impact zones) on two cloths from a0 and b0, at
-// ξ = 3 mm.
-SelfCollisionStats failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, Cloth& b,
-                                const TriMesh& bm, const VecX& b0) {
+// The pass with no CCD rounds (straight to the impact zones) at ξ = 3 mm on two cloths moving
+// from a0, b0 to a1, b1 in a 1/24 s step; it needs the impact zones once and leaves nothing
+// unresolved or frozen at x₀.
+void failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, const VecX& a1, Cloth& b,
+                  const TriMesh& bm, const VecX& b0, const VecX& b1) {
+    a.setPositions(a1);
+    b.setPositions(b1);
+    a.setVelocities(24.0 * (a1 - a0));
+    b.setVelocities(24.0 * (b1 - b0));
     SelfCollisionSettings settings;
     settings.ccdRounds = 0;
     SelfCollision sc(settings);
     sc.addBody(a, am.triangles, a0, 0.003);
     sc.addBody(b, bm.triangles, b0, 0.003);
-    return sc.resolve({a0, b0});
+    const SelfCollisionStats st = sc.resolve({a0, b0});
+    CHECK(st.failSafeRuns == 1);
+    CHECK(st.unresolved == 0);
+    CHECK(st.frozenVertices == 0);
 }
 
 } // namespace
@@ -318,10 +326,6 @@ TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self
         b1[3 * i + 1] -= 0.3 + 0.05 * i; // the upper one falls through it, tilting
         b1[3 * i] += 0.02 * i;
     }
-    a.setPositions(a1);
-    b.setPositions(b1);
-    a.setVelocities(24.0 * (a1 - a0));
-    b.setVelocities(24.0 * (b1 - b0));
     const auto momentum = [&](const VecX& da, const VecX& db) {
         Vec3 p = Vec3::Zero();
         for (int i = 0; i < 3; ++i)
@@ -329,10 +333,7 @@ TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self
         return p;
     };
     const Vec3 before = momentum(a1 - a0, b1 - b0);
-    const SelfCollisionStats st = failSafeOnly(a, lower, a0, b, upper, b0);
-    CHECK(st.failSafeRuns == 1);
-    CHECK(st.unresolved == 0);
-    CHECK(st.frozenVertices == 0);
+    failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
     const VecX& A1 = a.positions();
     const VecX& B1 = b.positions();
     // Momentum of the displacements kept (one zone holding all six vertices).
@@ -405,14 +406,7 @@ TEST_CASE("self-collision: an impact zone whose held vertices do not move togeth
     a1[3 * 2 + 1] += 0.05;
     a1[3 * 3 + 1] += 0.05;
     for (int i = 0; i < 3; ++i) b1[3 * i + 1] -= 0.3 + 0.05 * i; // through the quad, tilting
-    a.setPositions(a1);
-    b.setPositions(b1);
-    a.setVelocities(24.0 * (a1 - a0));
-    b.setVelocities(24.0 * (b1 - b0));
-    const SelfCollisionStats st = failSafeOnly(a, lower, a0, b, upper, b0);
-    CHECK(st.failSafeRuns == 1);
-    CHECK(st.unresolved == 0);
-    CHECK(st.frozenVertices == 0);
+    failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
     const VecX& A1 = a.positions();
     const VecX& B1 = b.positions();
     // The held corners end where their motion takes them.
