@@ -42,6 +42,7 @@ bool BandedLdlt::analyze(const Matrix& A) {
     mNew.assign(size, 0.0);
     mLd.assign(size, 0.0);
     mValid.assign(mStart.size() - 1, 0);
+    mSolvedValid.assign(mStart.size() - 1, 0);
     return true;
 }
 
@@ -86,8 +87,10 @@ bool BandedLdlt::factorize(const Matrix& A) {
         if (mValid[c] && std::memcmp(&mA[from], &mNew[from], count * sizeof(double)) == 0) continue;
         std::copy(mNew.begin() + from, mNew.begin() + from + count, mA.begin() + from);
         ++mRefactored;
+        mSolvedValid[c] = 0;
         if (!factorComponent(c)) {
             std::fill(mValid.begin(), mValid.end(), 0);
+            std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
             return false;
         }
         mValid[c] = 1;
@@ -95,27 +98,48 @@ bool BandedLdlt::factorize(const Matrix& A) {
     return true;
 }
 
-void BandedLdlt::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
-    x = b;
+void BandedLdlt::solveComponent(int c, double* x) const {
+    const int b = mStart[c], e = mStart[c + 1];
     const size_t row = static_cast<size_t>(mW) + 1;
-    // L y = b, D z = y, Lᵀ x = z (entries across components are zero: they stay apart).
-    for (int i = 0; i < mN; ++i) {
-        const int m = std::min(i, mW);
+    // L y = b, D z = y, Lᵀ x = z, within rows [b, e) (no entry couples them to another).
+    for (int i = b; i < e; ++i) {
+        const int m = std::min(i - b, mW);
         const double* li = &mLd[i * row + (mW - m)];
-        const double* xi = x.data() + (i - m);
+        const double* xi = x + (i - m);
         double s = x[i];
         for (int k = 0; k < m; ++k) s -= li[k] * xi[k];
         x[i] = s;
     }
-    for (int i = 0; i < mN; ++i) x[i] /= mLd[i * row + mW];
+    for (int i = b; i < e; ++i) x[i] /= mLd[i * row + mW];
     // Lᵀ: column i of L is spread over rows i + 1 .. i + w; scattered from each row instead.
-    for (int i = mN - 1; i >= 0; --i) {
-        const int m = std::min(i, mW);
+    for (int i = e - 1; i >= b; --i) {
+        const int m = std::min(i - b, mW);
         const double* li = &mLd[i * row + (mW - m)];
-        double* xi = x.data() + (i - m);
+        double* xi = x + (i - m);
         const double v = x[i];
         for (int k = 0; k < m; ++k) xi[k] -= li[k] * v;
     }
+}
+
+void BandedLdlt::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    mSolved = 0;
+    const bool have = mLastB.size() == mN && mLastX.size() == mN;
+    if (!have) {
+        mLastB.resize(mN);
+        mLastX.resize(mN);
+        std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
+    }
+    for (int c = 0; c + 1 < static_cast<int>(mStart.size()); ++c) {
+        const int from = mStart[c], count = mStart[c + 1] - mStart[c];
+        const size_t bytes = static_cast<size_t>(count) * sizeof(double);
+        if (mSolvedValid[c] && std::memcmp(&mLastB[from], &b[from], bytes) == 0) continue;
+        std::memcpy(&mLastB[from], &b[from], bytes);
+        std::memcpy(&mLastX[from], &b[from], bytes);
+        solveComponent(c, mLastX.data());
+        mSolvedValid[c] = 1;
+        ++mSolved;
+    }
+    x = mLastX;
 }
 
 } // namespace gale::solver

@@ -18,7 +18,8 @@ namespace gale::solver {
 // [b, e) with no entry coupling them to another (a strand of hair). A component's factor
 // depends on its own values only, so a factorisation after a change in a few components (the
 // contact active set's rounds: a vertex's filter changed) recomputes those and keeps the others,
-// the same bits as a full factorisation.
+// the same bits as a full factorisation; and a solve after such a change substitutes again
+// only in the components whose factor or right-hand side changed since the last solve.
 class BandedLdlt {
 public:
     using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor>;
@@ -36,8 +37,11 @@ public:
     // Components refactored by the last factorize().
     int lastRefactored() const { return mRefactored; }
 
-    // x = A⁻¹ b with the last factor (b and x may be the same vector).
-    void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+    // x = A⁻¹ b with the last factor (b and x may be the same vector). A component whose factor
+    // and b are those of the last solve takes that solve's x (the same bits).
+    void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+    // Components substituted by the last solve().
+    int lastSolved() const { return mSolved; }
 
 private:
     // Band storage: row i's entries A_i,i−w .. A_ii at mA[i (w + 1) + (j − i + w)]; the same
@@ -46,6 +50,7 @@ private:
         return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
     }
     bool factorComponent(int c);
+    void solveComponent(int c, double* x) const; // in place: b in, A⁻¹ b out
 
     int mN = 0, mW = 0;
     std::vector<int> mStart;  // component c is rows [mStart[c], mStart[c + 1])
@@ -55,6 +60,10 @@ private:
     std::vector<char> mValid; // per component: mLd holds its factor of mA
     std::vector<double> mScratch;
     int mRefactored = 0;
+    // The last solve: its b and x, and per component whether they belong to the current factor.
+    Eigen::VectorXd mLastB, mLastX;
+    std::vector<char> mSolvedValid;
+    int mSolved = 0;
 };
 
 } // namespace gale::solver
