@@ -490,12 +490,10 @@ void threadsBench(bool quick, int onlySize, int onlyThreads) {
 
 void stabilityBench(bool quick) {
     std::printf("\n## Edge-on stability (aero.md): 24x24 gossamer flag (0.005 kg/m^2, 2000 N/m), "
-                "uniform edge-on wind, "
-                "0.5 s, raw integrator (no substep halving, no Newton retry, no rotation "
-                "projection). 'ok' = finite and "
-                "within 5 m of the pole; 'recovered N' = N substeps in trouble (over-stretch, a "
-                "velocity jump) that the "
-                "last resort (Body::recover: strain limiting) brought back\n\n");
+                "uniform edge-on wind, 0.5 s, raw integrator (no substep halving, no Newton retry, "
+                "no rotation projection). 'ok' = finite and within 5 m of the pole; 'recovered N' "
+                "= N substeps in trouble (over-stretch, a velocity jump) that the last resort "
+                "(Body::recover: strain limiting) brought back\n\n");
     struct Variant {
         const char* name;
         AeroModel model;

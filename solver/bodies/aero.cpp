@@ -189,10 +189,11 @@ AeroResult aeroTriangle(const Vec3& vRel, const Vec3& areaNormal, double rho, do
     case AeroJacobian::Projected: {
         // The symmetric part of the exact Jacobian written out in the basis (n, e, b),
         // v = s n + q e, r² = s² + q², as M = [[a11, a12], [a12, a22]] on (n, e) and c on b:
-        //   frozen:      M = k [[2 C_D s, (C_D + C_L) q/2], [·, (C_D − C_L) s]],  c = k (C_D − C_L)
-        //   s smooth-lift: M = k [[2 C_D s + C_L q⁴/r³, C_D q/2 + C_L s q (s² − q²)/(2r³)],
-        //                       [·, C_D s − C_L s⁴/r³]],                    c = k (C_D s − C_L
-        //                       s²/r)
+        //   frozen:      M = k [[2 C_D s, (C_D + C_L) q/2], [·, (C_D − C_L) s]],
+        //                c = k (C_D − C_L) s
+        //   smooth-lift: M = k [[2 C_D s + C_L q⁴/r³, C_D q/2 + C_L s q (s² − q²)/(2r³)],
+        //                       [·, C_D s − C_L s⁴/r³]],
+        //                c = k (C_D s − C_L s²/r)
         // (smooth-lift in the bounded ratios σ = s/r, κ = q/r: q⁴/r³ = q κ³, s⁴/r³ = s σ³, ...).
         // Projected: projectPsdInPlane(aeroTriangleExactJacobian(..), n, v) in closed form.
         // Bounded: the coupling a12 moved onto the diagonal, diag(a11 + |a12|, a22 + |a12|) ⪰ M

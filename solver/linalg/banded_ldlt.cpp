@@ -43,6 +43,8 @@ bool BandedLdlt::analyze(const Matrix& A) {
     mLd.assign(size, 0.0);
     mValid.assign(mStart.size() - 1, 0);
     mSolvedValid.assign(mStart.size() - 1, 0);
+    mLastB.setZero(n);
+    mLastX.setZero(n);
     return true;
 }
 
@@ -123,12 +125,6 @@ void BandedLdlt::solveComponent(int c, double* x) const {
 
 void BandedLdlt::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     mSolved = 0;
-    const bool have = mLastB.size() == mN && mLastX.size() == mN;
-    if (!have) {
-        mLastB.resize(mN);
-        mLastX.resize(mN);
-        std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
-    }
     for (int c = 0; c + 1 < static_cast<int>(mStart.size()); ++c) {
         const int from = mStart[c], count = mStart[c + 1] - mStart[c];
         const size_t bytes = static_cast<size_t>(count) * sizeof(double);

@@ -492,6 +492,8 @@ bool SelfCollision::rigidZone(const std::vector<int>& members) const {
     return true;
 }
 
+namespace {
+
 // The motion x₁ = x₀ + D + ω_d × (x₀ − c), v = V + ω_v × (x₀ − c) with the linear and angular
 // momentum of `members`' displacements and velocities (weights `weight(i)`): D = Σ w d / Σ w,
 // ω = I⁻¹ Σ w r × (d − D), r = x₀ − c, I = Σ w (|r|² I − r rᵀ). Its linear part I + t[ω_d]× has
@@ -534,6 +536,8 @@ struct ZoneMotion {
         vec3At(v.data(), i) = V + wv.cross(r);
     }
 };
+
+} // namespace
 
 void SelfCollision::applyZone(const std::vector<int>& members) {
     // Pins and attachments in the zone (their own motion kept): the free vertices take the
@@ -586,6 +590,7 @@ void SelfCollision::impactZones(std::vector<Pair>& hits) {
     }
     long long zoneCount = 0;
     for (uint8_t z : inZone) zoneCount += z;
+    mStats.zoneVertices += zoneCount;
     // Last resort: free vertices of the zones and of the pairs still hitting stay at x₀.
     for (int r = 0; r < 16 && !hits.empty(); ++r) {
         for (const Pair& p : hits)

@@ -284,8 +284,8 @@ namespace {
 
 // The pass with no CCD rounds (straight to the impact zones) at ξ = 3 mm on two cloths moving
 // from a0, b0 to a1, b1 in a 1/24 s step; it needs the impact zones once and leaves nothing
-// unresolved or frozen at x₀.
-void failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, const VecX& a1, Cloth& b,
+// unresolved or frozen at x₀. Returns its counts.
+SelfCollisionStats failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, const VecX& a1, Cloth& b,
                   const TriMesh& bm, const VecX& b0, const VecX& b1) {
     a.setPositions(a1);
     b.setPositions(b1);
@@ -300,6 +300,7 @@ void failSafeOnly(Cloth& a, const TriMesh& am, const VecX& a0, const VecX& a1, C
     CHECK(st.failSafeRuns == 1);
     CHECK(st.unresolved == 0);
     CHECK(st.frozenVertices == 0);
+    return st;
 }
 
 } // namespace
@@ -333,7 +334,8 @@ TEST_CASE("self-collision: the impact-zone fail-safe on its own", "[solver][self
         return p;
     };
     const Vec3 before = momentum(a1 - a0, b1 - b0);
-    failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
+    const SelfCollisionStats st = failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
+    CHECK(st.zoneVertices == 6); // one zone: both triangles' vertices
     const VecX& A1 = a.positions();
     const VecX& B1 = b.positions();
     // Momentum of the displacements kept (one zone holding all six vertices).
@@ -406,7 +408,9 @@ TEST_CASE("self-collision: an impact zone whose held vertices do not move togeth
     a1[3 * 2 + 1] += 0.05;
     a1[3 * 3 + 1] += 0.05;
     for (int i = 0; i < 3; ++i) b1[3 * i + 1] -= 0.3 + 0.05 * i; // through the quad, tilting
-    failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
+    const SelfCollisionStats st = failSafeOnly(a, lower, a0, a1, b, upper, b0, b1);
+    CAPTURE(st.zoneVertices);
+    CHECK(st.zoneVertices >= 6); // the triangle and a quad triangle it goes through, at least
     const VecX& A1 = a.positions();
     const VecX& B1 = b.positions();
     // The held corners end where their motion takes them.
