@@ -35,6 +35,10 @@ bool BandedLdlt::analyze(const Matrix& A) {
     }
     mStart.push_back(n);
     if (n == 0) mStart.assign(1, 0);
+    mRowComponent.assign(static_cast<size_t>(n), 0);
+    for (size_t c = 0; c + 1 < mStart.size(); ++c)
+        std::fill(mRowComponent.begin() + mStart[c], mRowComponent.begin() + mStart[c + 1],
+                  static_cast<int>(c));
     mN = n;
     mW = w;
     const size_t size = static_cast<size_t>(n) * (w + 1);
@@ -88,6 +92,25 @@ bool BandedLdlt::factorize(const Matrix& A) {
         const size_t from = mStart[c] * row, count = (mStart[c + 1] - mStart[c]) * row;
         if (mValid[c] && std::memcmp(&mA[from], &mNew[from], count * sizeof(double)) == 0) continue;
         std::copy(mNew.begin() + from, mNew.begin() + from + count, mA.begin() + from);
+        ++mRefactored;
+        mSolvedValid[c] = 0;
+        if (!factorComponent(c)) {
+            std::fill(mValid.begin(), mValid.end(), 0);
+            std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
+            return false;
+        }
+        mValid[c] = 1;
+    }
+    return true;
+}
+
+bool BandedLdlt::refactor(const std::vector<char>& changed, const std::function<void(int)>& fill) {
+    mRefactored = 0;
+    const size_t row = static_cast<size_t>(mW) + 1;
+    for (int c = 0; c + 1 < static_cast<int>(mStart.size()); ++c) {
+        if (mValid[c] && !changed[static_cast<size_t>(c)]) continue;
+        std::fill(mA.begin() + mStart[c] * row, mA.begin() + mStart[c + 1] * row, 0.0);
+        fill(c);
         ++mRefactored;
         mSolvedValid[c] = 0;
         if (!factorComponent(c)) {

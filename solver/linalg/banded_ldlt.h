@@ -5,6 +5,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <vector>
 
 namespace gale::solver {
@@ -34,8 +35,20 @@ public:
     // last successful factorisation's. False when a pivot D_i is not positive and finite (A not
     // SPD, or not finite): nothing is then kept and the next call factors every component.
     bool factorize(const Matrix& A);
-    // Components refactored by the last factorize().
+    // Components refactored by the last factorize() or refactor().
     int lastRefactored() const { return mRefactored; }
+
+    // The same factorisation when the caller knows which components changed (the matrix held
+    // in another form: FilteredSolver's block rows): for each component c marked in `changed`,
+    // or without a valid factor, its rows are zeroed, fill(c) writes its lower band with set(),
+    // and it is factored; the others keep their factor. False as factorize().
+    bool refactor(const std::vector<char>& changed, const std::function<void(int)>& fill);
+    // A_ij during refactor()'s fill: i ≥ j, i − j ≤ halfBandwidth(), both in the component.
+    void set(int i, int j, double value) { band(mA, i, j) = value; }
+    // The component of row i, and a component's rows [first, last).
+    int componentOf(int i) const { return mRowComponent[static_cast<size_t>(i)]; }
+    int firstRow(int c) const { return mStart[static_cast<size_t>(c)]; }
+    int endRow(int c) const { return mStart[static_cast<size_t>(c) + 1]; }
 
     // x = A⁻¹ b with the last factor (b and x may be the same vector). A component whose factor
     // and b are those of the last solve takes that solve's x (the same bits).
@@ -54,6 +67,7 @@ private:
 
     int mN = 0, mW = 0;
     std::vector<int> mStart;  // component c is rows [mStart[c], mStart[c + 1])
+    std::vector<int> mRowComponent; // per row, its component
     std::vector<double> mA;   // A's band as last factored
     std::vector<double> mNew; // the band of the A being factored (scratch)
     std::vector<double> mLd;  // the factor: L below the diagonal, D on it

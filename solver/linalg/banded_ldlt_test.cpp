@@ -140,3 +140,55 @@ TEST_CASE("banded LDLT: a matrix that is not positive definite is refused", "[li
     A(2, 2) = std::nan("");
     CHECK_FALSE(f.factorize(sparse(A)));
 }
+
+TEST_CASE("banded LDLT: refactor() of the marked strands gives factorize()'s bits",
+          "[linalg][banded]") {
+    // The caller that holds the matrix in another form (FilteredSolver's blocks) writes the
+    // changed strands' bands itself.
+    std::mt19937 rng(21);
+    const std::vector<int> lengths = {9, 9, 9, 9};
+    Eigen::MatrixXd A = strands(lengths, 5, rng);
+    const auto fillFrom = [](BandedLdlt& f, const Eigen::MatrixXd& M) {
+        return [&f, &M](int c) {
+            for (int i = f.firstRow(c); i < f.endRow(c); ++i)
+                for (int j = std::max(f.firstRow(c), i - f.halfBandwidth()); j <= i; ++j)
+                    f.set(i, j, M(i, j));
+        };
+    };
+    BandedLdlt f;
+    REQUIRE(f.analyze(sparse(A)));
+    CHECK(f.componentOf(0) == 0);
+    CHECK(f.componentOf(20) == 2);
+    CHECK(f.firstRow(2) == 18);
+    CHECK(f.endRow(2) == 27);
+    // Nothing factored yet: every strand, marked or not.
+    std::vector<char> changed(4, 0);
+    REQUIRE(f.refactor(changed, fillFrom(f, A)));
+    CHECK(f.lastRefactored() == 4);
+    // Strand 1 changes; only it is marked and refactored.
+    A(12, 10) = A(10, 12) = 0.5;
+    A(12, 12) += 2.0;
+    changed[1] = 1;
+    REQUIRE(f.refactor(changed, fillFrom(f, A)));
+    CHECK(f.lastRefactored() == 1);
+    BandedLdlt fresh;
+    REQUIRE(fresh.analyze(sparse(A)));
+    REQUIRE(fresh.factorize(sparse(A)));
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), 2.0, -1.0);
+    Eigen::VectorXd x, y;
+    f.solve(b, x);
+    fresh.solve(b, y);
+    CHECK(x == y); // bit for bit
+    // factorize() afterwards sees the band refactor() wrote: nothing changed.
+    REQUIRE(f.factorize(sparse(A)));
+    CHECK(f.lastRefactored() == 0);
+    // Refused as factorize() refuses, and everything refactored after.
+    Eigen::MatrixXd bad = A;
+    bad(30, 30) = -1.0;
+    std::fill(changed.begin(), changed.end(), 0);
+    changed[3] = 1;
+    CHECK_FALSE(f.refactor(changed, fillFrom(f, bad)));
+    changed[3] = 0;
+    REQUIRE(f.refactor(changed, fillFrom(f, A)));
+    CHECK(f.lastRefactored() == 4);
+}

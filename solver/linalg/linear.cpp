@@ -407,65 +407,126 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
     return st;
 }
 
+namespace {
+// Block (i, j) of the filtered matrix S A S + I − S: S_i B S_j, plus I − S_j on the diagonal.
+Mat3 filteredBlock(const Mat3& B, const Constraints& c, int i, int j) {
+    Mat3 F = c.filter(static_cast<size_t>(i)) * B * c.filter(static_cast<size_t>(j));
+    if (i == j) F += Mat3::Identity() - c.filter(static_cast<size_t>(j));
+    return F;
+}
+} // namespace
+
+bool FilteredSolver::factorBanded(const BlockMatrix& A, const Constraints& c) {
+    // The components (strands) whose block rows changed since the last factorisation: a block's
+    // values, or the filter of the row's vertex (a block (i, j) couples i's component only to
+    // itself, so j's filter changing marks j's component, which is i's). Their bands are
+    // written straight from the blocks, filtered; the others keep their factor.
+    const int n = A.size();
+    const size_t slots = static_cast<size_t>(A.slotCount());
+    const double* val = A.values();
+    const std::vector<int>& start = A.blockRowStart();
+    const std::vector<int>& cols = A.blockCols();
+    const bool constrained = !c.kind.empty() && c.any();
+    const auto kindOf = [&](int i) { return constrained ? c.kind[static_cast<size_t>(i)] : 0; };
+    const bool fresh =
+        mBandValues.size() != 9 * slots || mBandKind.size() != static_cast<size_t>(n);
+    mBandChanged.assign(static_cast<size_t>(mLdltBanded->components()), fresh ? 1 : 0);
+    mBandValues.resize(9 * slots);
+    mBandKind.resize(static_cast<size_t>(n));
+    mBandNormal.resize(3 * static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const uint8_t kind = kindOf(i);
+        const double* normal = constrained ? c.normal.data() + 3 * i : nullptr;
+        const size_t from = 9 * static_cast<size_t>(start[i]);
+        const size_t count = 9 * static_cast<size_t>(start[i + 1] - start[i]);
+        bool changed = fresh || kind != mBandKind[static_cast<size_t>(i)] ||
+                       std::memcmp(val + from, mBandValues.data() + from, count * sizeof(double));
+        if (!changed && kind == 2)
+            changed = std::memcmp(normal, mBandNormal.data() + 3 * i, 3 * sizeof(double)) != 0;
+        if (!changed) continue;
+        mBandChanged[static_cast<size_t>(mLdltBanded->componentOf(3 * i))] = 1;
+        std::memcpy(mBandValues.data() + from, val + from, count * sizeof(double));
+        mBandKind[static_cast<size_t>(i)] = kind;
+        if (kind == 2) std::memcpy(mBandNormal.data() + 3 * i, normal, 3 * sizeof(double));
+    }
+    BandedLdlt& ldlt = *mLdltBanded;
+    return ldlt.refactor(mBandChanged, [&](int comp) {
+        for (int i = ldlt.firstRow(comp) / 3; i < ldlt.endRow(comp) / 3; ++i)
+            for (int k = start[i]; k < start[i + 1] && cols[k] <= i; ++k) {
+                const int j = cols[k];
+                const Mat3 B = Eigen::Map<const Mat3>(val + 9 * static_cast<size_t>(k));
+                const Mat3 F = kindOf(i) || kindOf(j) ? filteredBlock(B, c, i, j) : B;
+                for (int r = 0; r < 3; ++r)
+                    for (int a = 0; a < 3 && 3 * j + a <= 3 * i + r; ++a)
+                        ldlt.set(3 * i + r, 3 * j + a, F(r, a));
+            }
+    });
+}
+
 SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
                                         VecX& y) {
     SolveStatus st;
-    // The scalar matrix (its pattern built once), then the constrained block rows and columns
-    // filtered.
     if (mFilteredA.rows() != 3 * A.size() || mFilteredA.nonZeros() != 9L * A.slotCount()) {
         mLdlt.reset();
         mLdltBanded.reset();
-    }
-    A.toScalar(mFilteredA);
-    const bool constrained = !c.kind.empty() && c.any();
-    if (constrained) {
-        // Column-major over a symmetric pattern: column 3j+a lists rows; entry (r, col).
-        const int* outer = mFilteredA.outerIndexPtr();
-        const int* inner = mFilteredA.innerIndexPtr();
-        double* val = mFilteredA.valuePtr();
-        const int n = A.size();
-        for (int j = 0; j < n; ++j) {
-            // Process block column j: for each block row i present, B ← S_i B S_j (+ I − S_j on
-            // the diagonal).
-            for (int p = outer[3 * j]; p < outer[3 * j + 1]; p += 3) {
-                const int i = inner[p] / 3;
-                if (!c.kind[i] && !c.kind[j]) continue;
-                const int stride = outer[3 * j + 1] - outer[3 * j];
-                Mat3 B;
-                for (int a = 0; a < 3; ++a)     // column offset
-                    for (int r = 0; r < 3; ++r) // row offset
-                        B(r, a) = val[p + a * stride + r];
-                const Mat3 Si = c.filter(i), Sj = c.filter(j);
-                Mat3 F = Si * B * Sj;
-                if (i == j) F += Mat3::Identity() - Sj;
-                for (int a = 0; a < 3; ++a)
-                    for (int r = 0; r < 3; ++r) val[p + a * stride + r] = F(r, a);
-            }
-        }
-    }
-    if (!mLdlt && !mLdltBanded) {
-        // Natural order when the block pattern is a band at most kBandedOrder blocks wide.
-        constexpr int kBandedOrder = 4;
-        int band = 0;
-        for (int i = 0; i < A.size(); ++i)
-            for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
-                band = std::max(band, std::abs(A.blockCols()[k] - i));
-        if (band <= kBandedOrder) {
-            mLdltBanded = std::make_unique<BandedLdlt>();
-            mLdltBanded->analyze(mFilteredA);
-        } else {
-            mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
-            mLdlt->analyzePattern(mFilteredA);
-        }
+        mBandValues.clear();
     }
     bool ok;
     if (mLdltBanded) {
-        ok = mLdltBanded->factorize(mFilteredA);
+        // A band (hair), analysed: written and refactored by the components that changed.
+        ok = factorBanded(A, c);
         if (ok) mLdltBanded->solve(rhs, y);
     } else {
-        mLdlt->factorize(mFilteredA);
-        ok = mLdlt->info() == Eigen::Success;
-        if (ok) y = mLdlt->solve(rhs);
+        // The scalar matrix (its pattern built once), then the constrained block rows and
+        // columns filtered.
+        A.toScalar(mFilteredA);
+        const bool constrained = !c.kind.empty() && c.any();
+        if (constrained) {
+            // Column-major over a symmetric pattern: column 3j+a lists rows; entry (r, col).
+            const int* outer = mFilteredA.outerIndexPtr();
+            const int* inner = mFilteredA.innerIndexPtr();
+            double* val = mFilteredA.valuePtr();
+            const int n = A.size();
+            for (int j = 0; j < n; ++j) {
+                // Block column j: for each block row i present, B ← S_i B S_j (+ I − S_j on the
+                // diagonal).
+                for (int p = outer[3 * j]; p < outer[3 * j + 1]; p += 3) {
+                    const int i = inner[p] / 3;
+                    if (!c.kind[i] && !c.kind[j]) continue;
+                    const int stride = outer[3 * j + 1] - outer[3 * j];
+                    Mat3 B;
+                    for (int a = 0; a < 3; ++a)     // column offset
+                        for (int r = 0; r < 3; ++r) // row offset
+                            B(r, a) = val[p + a * stride + r];
+                    const Mat3 F = filteredBlock(B, c, i, j);
+                    for (int a = 0; a < 3; ++a)
+                        for (int r = 0; r < 3; ++r) val[p + a * stride + r] = F(r, a);
+                }
+            }
+        }
+        if (!mLdlt) {
+            // Natural order when the block pattern is a band at most kBandedOrder blocks wide.
+            constexpr int kBandedOrder = 4;
+            int band = 0;
+            for (int i = 0; i < A.size(); ++i)
+                for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
+                    band = std::max(band, std::abs(A.blockCols()[k] - i));
+            if (band <= kBandedOrder) {
+                mLdltBanded = std::make_unique<BandedLdlt>();
+                mLdltBanded->analyze(mFilteredA);
+            } else {
+                mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
+                mLdlt->analyzePattern(mFilteredA);
+            }
+        }
+        if (mLdltBanded) {
+            ok = factorBanded(A, c);
+            if (ok) mLdltBanded->solve(rhs, y);
+        } else {
+            mLdlt->factorize(mFilteredA);
+            ok = mLdlt->info() == Eigen::Success;
+            if (ok) y = mLdlt->solve(rhs);
+        }
     }
     if (!ok) {
         st.failed = true;

@@ -163,6 +163,13 @@ private:
     // copies it, permute_symm_to_symm: 8 % of examples/10_hair_turn's time), and only the
     // strands whose filtered values changed refactored (the contact active set's rounds).
     std::unique_ptr<BandedLdlt> mLdltBanded;
+    // The banded factor's block rows as last written (values, each vertex's filter kind and
+    // plane normal): a round compares against them and rewrites only the strands that changed,
+    // from the blocks (no scalar copy of the whole matrix a round).
+    bool factorBanded(const BlockMatrix& A, const Constraints& c);
+    std::vector<double> mBandValues, mBandNormal;
+    std::vector<uint8_t> mBandKind;
+    std::vector<char> mBandChanged;
 };
 
 } // namespace gale::solver
