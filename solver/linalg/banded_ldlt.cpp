@@ -92,15 +92,20 @@ bool BandedLdlt::factorize(const Matrix& A) {
         const size_t from = mStart[c] * row, count = (mStart[c + 1] - mStart[c]) * row;
         if (mValid[c] && std::memcmp(&mA[from], &mNew[from], count * sizeof(double)) == 0) continue;
         std::copy(mNew.begin() + from, mNew.begin() + from + count, mA.begin() + from);
-        ++mRefactored;
-        mSolvedValid[c] = 0;
-        if (!factorComponent(c)) {
-            std::fill(mValid.begin(), mValid.end(), 0);
-            std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
-            return false;
-        }
-        mValid[c] = 1;
+        if (!refactorComponent(c)) return false;
     }
+    return true;
+}
+
+bool BandedLdlt::refactorComponent(int c) {
+    ++mRefactored;
+    mSolvedValid[c] = 0;
+    if (!factorComponent(c)) {
+        std::fill(mValid.begin(), mValid.end(), 0);
+        std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
+        return false;
+    }
+    mValid[c] = 1;
     return true;
 }
 
@@ -111,14 +116,7 @@ bool BandedLdlt::refactor(const std::vector<char>& changed, const std::function<
         if (mValid[c] && !changed[static_cast<size_t>(c)]) continue;
         std::fill(mA.begin() + mStart[c] * row, mA.begin() + mStart[c + 1] * row, 0.0);
         fill(c);
-        ++mRefactored;
-        mSolvedValid[c] = 0;
-        if (!factorComponent(c)) {
-            std::fill(mValid.begin(), mValid.end(), 0);
-            std::fill(mSolvedValid.begin(), mSolvedValid.end(), 0);
-            return false;
-        }
-        mValid[c] = 1;
+        if (!refactorComponent(c)) return false;
     }
     return true;
 }

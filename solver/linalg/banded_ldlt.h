@@ -63,6 +63,8 @@ private:
         return v[static_cast<size_t>(i) * (mW + 1) + (j - i + mW)];
     }
     bool factorComponent(int c);
+    // Component c's factor from mA, counted; on failure every factor is forgotten (false).
+    bool refactorComponent(int c);
     void solveComponent(int c, double* x) const; // in place: b in, A⁻¹ b out
 
     int mN = 0, mW = 0;

@@ -9,16 +9,12 @@
 
 using namespace gale::solver;
 
-TEST_CASE("linear: PCG and LDLT solve the filtered system alike", "[linear]") {
-    const int n = 60;
-    std::mt19937 rng(9);
+namespace {
+// SPD: a random mass on the diagonal plus, for each pair, a PSD coupling [B, −B; −B, B].
+void randomSpd(BlockMatrix& A, int n, const std::vector<std::pair<int, int>>& pairs,
+               std::mt19937& rng) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    std::vector<std::pair<int, int>> pairs;
-    for (int i = 0; i + 1 < n; ++i) pairs.push_back({i, i + 1});
-    for (int i = 0; i + 7 < n; i += 3) pairs.push_back({i, i + 7});
-    BlockMatrix A;
     A.build(n, pairs);
-    // SPD: M + Σ over pairs of a PSD coupling [B, −B; −B, B].
     for (int i = 0; i < n; ++i) A.addDiagonal(A.diagonalSlot(i), 0.5 + 0.5 * (u(rng) + 1));
     for (const auto& p : pairs) {
         Eigen::Matrix3d R = Eigen::Matrix3d::NullaryExpr([&] { return u(rng); });
@@ -28,6 +24,18 @@ TEST_CASE("linear: PCG and LDLT solve the filtered system alike", "[linear]") {
         A.addBlock(A.slot(p.first, p.second), B, -1.0);
         A.addBlock(A.slot(p.second, p.first), B, -1.0);
     }
+}
+} // namespace
+
+TEST_CASE("linear: PCG and LDLT solve the filtered system alike", "[linear]") {
+    const int n = 60;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<std::pair<int, int>> pairs;
+    for (int i = 0; i + 1 < n; ++i) pairs.push_back({i, i + 1});
+    for (int i = 0; i + 7 < n; i += 3) pairs.push_back({i, i + 7});
+    BlockMatrix A;
+    randomSpd(A, n, pairs, rng);
     VecX b(3 * n);
     for (int k = 0; k < 3 * n; ++k) b[k] = u(rng);
     Constraints c;
@@ -80,16 +88,7 @@ TEST_CASE("linear: the direct solve of strands across a contact's rounds", "[lin
             if (k + 2 < per) pairs.push_back({i, i + 2});
         }
     BlockMatrix A;
-    A.build(n, pairs);
-    for (int i = 0; i < n; ++i) A.addDiagonal(A.diagonalSlot(i), 0.5 + 0.5 * (u(rng) + 1));
-    for (const auto& p : pairs) {
-        Eigen::Matrix3d R = Eigen::Matrix3d::NullaryExpr([&] { return u(rng); });
-        const Mat3 B = R * R.transpose() * 20.0;
-        A.addBlock(A.slot(p.first, p.first), B);
-        A.addBlock(A.slot(p.second, p.second), B);
-        A.addBlock(A.slot(p.first, p.second), B, -1.0);
-        A.addBlock(A.slot(p.second, p.first), B, -1.0);
-    }
+    randomSpd(A, n, pairs, rng);
     VecX b(3 * n);
     for (int k = 0; k < 3 * n; ++k) b[k] = u(rng);
     Constraints c;
