@@ -471,17 +471,34 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
         mLdltBanded.reset();
         mBandValues.clear();
     }
+    // The first solve of a pattern: the scalar matrix (its pattern is what the analyses read),
+    // and the factorisation's kind.
+    const bool analyse = !mLdlt && !mLdltBanded;
+    if (analyse) {
+        A.toScalar(mFilteredA);
+        // Natural order when the block pattern is a band at most kBandedOrder blocks wide.
+        constexpr int kBandedOrder = 4;
+        int band = 0;
+        for (int i = 0; i < A.size(); ++i)
+            for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
+                band = std::max(band, std::abs(A.blockCols()[k] - i));
+        if (band <= kBandedOrder) {
+            mLdltBanded = std::make_unique<BandedLdlt>();
+            mLdltBanded->analyze(mFilteredA);
+        } else {
+            mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
+            mLdlt->analyzePattern(mFilteredA);
+        }
+    }
     bool ok;
     if (mLdltBanded) {
-        // A band (hair), analysed: written and refactored by the components that changed.
+        // A band (hair): written from the blocks and refactored by the strands that changed.
         ok = factorBanded(A, c);
         if (ok) mLdltBanded->solve(rhs, y);
     } else {
-        // The scalar matrix (its pattern built once), then the constrained block rows and
-        // columns filtered.
-        A.toScalar(mFilteredA);
-        const bool constrained = !c.kind.empty() && c.any();
-        if (constrained) {
+        // The scalar matrix's values, then the constrained block rows and columns filtered.
+        if (!analyse) A.toScalar(mFilteredA);
+        if (!c.kind.empty() && c.any()) {
             // Column-major over a symmetric pattern: column 3j+a lists rows; entry (r, col).
             const int* outer = mFilteredA.outerIndexPtr();
             const int* inner = mFilteredA.innerIndexPtr();
@@ -504,29 +521,9 @@ SolveStatus FilteredSolver::solveDirect(const BlockMatrix& A, const Constraints&
                 }
             }
         }
-        if (!mLdlt) {
-            // Natural order when the block pattern is a band at most kBandedOrder blocks wide.
-            constexpr int kBandedOrder = 4;
-            int band = 0;
-            for (int i = 0; i < A.size(); ++i)
-                for (int k = A.blockRowStart()[i]; k < A.blockRowStart()[i + 1]; ++k)
-                    band = std::max(band, std::abs(A.blockCols()[k] - i));
-            if (band <= kBandedOrder) {
-                mLdltBanded = std::make_unique<BandedLdlt>();
-                mLdltBanded->analyze(mFilteredA);
-            } else {
-                mLdlt = std::make_unique<Eigen::SimplicialLDLT<ColMatrix>>();
-                mLdlt->analyzePattern(mFilteredA);
-            }
-        }
-        if (mLdltBanded) {
-            ok = factorBanded(A, c);
-            if (ok) mLdltBanded->solve(rhs, y);
-        } else {
-            mLdlt->factorize(mFilteredA);
-            ok = mLdlt->info() == Eigen::Success;
-            if (ok) y = mLdlt->solve(rhs);
-        }
+        mLdlt->factorize(mFilteredA);
+        ok = mLdlt->info() == Eigen::Success;
+        if (ok) y = mLdlt->solve(rhs);
     }
     if (!ok) {
         st.failed = true;

@@ -10,9 +10,10 @@
 using namespace gale::solver;
 
 namespace {
-// SPD: a random mass on the diagonal plus, for each pair, a PSD coupling [B, −B; −B, B].
-void randomSpd(BlockMatrix& A, int n, const std::vector<std::pair<int, int>>& pairs,
-               std::mt19937& rng) {
+// A random system: A SPD, a random mass on the diagonal plus, for each pair, a PSD coupling
+// [B, −B; −B, B]; returns a random right-hand side.
+VecX randomSystem(BlockMatrix& A, int n, const std::vector<std::pair<int, int>>& pairs,
+                  std::mt19937& rng) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     A.build(n, pairs);
     for (int i = 0; i < n; ++i) A.addDiagonal(A.diagonalSlot(i), 0.5 + 0.5 * (u(rng) + 1));
@@ -24,20 +25,20 @@ void randomSpd(BlockMatrix& A, int n, const std::vector<std::pair<int, int>>& pa
         A.addBlock(A.slot(p.first, p.second), B, -1.0);
         A.addBlock(A.slot(p.second, p.first), B, -1.0);
     }
+    VecX b(3 * n);
+    for (int k = 0; k < 3 * n; ++k) b[k] = u(rng);
+    return b;
 }
 } // namespace
 
 TEST_CASE("linear: PCG and LDLT solve the filtered system alike", "[linear]") {
     const int n = 60;
     std::mt19937 rng(9);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<std::pair<int, int>> pairs;
     for (int i = 0; i + 1 < n; ++i) pairs.push_back({i, i + 1});
     for (int i = 0; i + 7 < n; i += 3) pairs.push_back({i, i + 7});
     BlockMatrix A;
-    randomSpd(A, n, pairs, rng);
-    VecX b(3 * n);
-    for (int k = 0; k < 3 * n; ++k) b[k] = u(rng);
+    const VecX b = randomSystem(A, n, pairs, rng);
     Constraints c;
     c.reset(n);
     c.kind[0] = 1;
@@ -79,7 +80,6 @@ TEST_CASE("linear: the direct solve of strands across a contact's rounds", "[lin
     // filtered system.
     const int strands = 5, per = 7, n = strands * per;
     std::mt19937 rng(31);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<std::pair<int, int>> pairs;
     for (int s = 0; s < strands; ++s)
         for (int k = 0; k < per; ++k) {
@@ -88,9 +88,7 @@ TEST_CASE("linear: the direct solve of strands across a contact's rounds", "[lin
             if (k + 2 < per) pairs.push_back({i, i + 2});
         }
     BlockMatrix A;
-    randomSpd(A, n, pairs, rng);
-    VecX b(3 * n);
-    for (int k = 0; k < 3 * n; ++k) b[k] = u(rng);
+    const VecX b = randomSystem(A, n, pairs, rng);
     Constraints c;
     c.reset(n);
     for (int s = 0; s < strands; ++s) c.kind[s * per] = 1; // the roots
