@@ -264,6 +264,7 @@ function events() {
   const es = new EventSource('/api/events?token=' + encodeURIComponent(token));
   // (The tests read when each event arrived: [type, ms since the page loaded].)
   live.events = [];
+  live.simLog = []; // (every sim event and Simulate press, for a test's failure report)
   for (const type of ['field', 'diagnostics', 'frame', 'sim']) es.addEventListener(type, () => live.events.push([type, performance.now()]));
   es.addEventListener('error', () => live.events.push(['error', performance.now()]));
   es.addEventListener('field', async () => {
@@ -284,6 +285,7 @@ function events() {
   });
   es.addEventListener('sim', (e) => {
     const s = JSON.parse(e.data);
+    live.simLog.push(['event', simRun, $('simulate').textContent, { ...s, log: undefined }]);
     if (s.running && s.run !== undefined) {
       if (s.restart) {
         // An edit restarted the simulation: the old run's frames stay, greyed, until replaced.
@@ -340,12 +342,14 @@ function wire() {
         drawSimFrame();
       }
       const r = await api('/api/simulate', { action: running ? 'stop' : 'start' });
+      live.simLog.push(['press', simRun, running ? 'Stop' : 'Simulate', r]);
       // The button follows `on` (Simulate pressed and not stopped: a run that ended by itself
       // leaves it on, and edits re-simulate), so a Stop after the run's end turns it off.
       $('simulate').textContent = r.running || r.on ? 'Stop' : 'Simulate';
       // (A short run may have ended, and its event been shown, before this reply.)
       if (r.run !== endedRun) $('simText').textContent = r.running ? 'simulating…' : '';
     } catch (e) {
+      live.simLog.push(['press failed', simRun, String(e.message || e)]);
       $('simText').textContent = String(e.message || e);
     }
   };

@@ -2,6 +2,7 @@
 // by the active set after each solve, Coulomb friction implicit in the solve, cloth held against
 // cloth, and the push-out after the solve (Baraff & Witkin 1998 §5; docs/solver.md, "Contact").
 #include "solver/bodies/body.h"
+#include "solver/collider/mesh_collider.h"
 #include "solver/collider/moving_collider.h"
 
 #include <algorithm>
@@ -24,6 +25,35 @@ constexpr double kFrictionChange = 0.01;
 constexpr double kSlipFloor = 1e-3;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
+} // namespace
+
+namespace {
+
+// Where the path a → b of a vertex first comes within `reach` of a static mesh collider (its
+// SDF, 1-Lipschitz: conservative advancement, each step the distance still to go, a tenth
+// short of it for the trilinear interpolation's slack), in `at` with the query there in `cp`.
+// False when a is within reach already (a vertex that starts inside has only its closest point)
+// or the path never comes that close. A static mesh's closest point to the end of a step can
+// lie on another face than the one the vertex came through: a sheet landing flat on a 24 cm
+// box, its vertices 4 cm into the top and 3.7 cm from a side, was pushed out of the side and up
+// (the top's edges 1.5–1.8× rest at one substep a frame; bench/README.md).
+bool pathEntry(const MeshCollider& mesh, const Vec3& a, const Vec3& b, double reach, Vec3& at,
+               ContactPoint& cp) {
+    const double len = (b - a).norm();
+    if (!(len > 0.0)) return false;
+    double s = 0.0; // m along the path
+    for (int it = 0; it < 64; ++it) {
+        at = a + (s / len) * (b - a);
+        mesh.query(at, cp.distance, cp.normal);
+        const double gap = cp.distance - reach;
+        if (!(gap > 0.0)) return it > 0;
+        if (gap < 0.02 * reach) return true; // on the surface, to 2 % of the thickness
+        s += 0.9 * gap;
+        if (s >= len) return false;
+    }
+    return true; // (grazing: close enough, outside)
+}
+
 } // namespace
 
 // The contact plane of vertex i, made from a query cp of collider `ci` at point p and time tq
@@ -385,7 +415,8 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         struct NewContact {
             size_t i;
             ContactPoint cp;
-            Vec3 x1, v1;
+            Vec3 at, v1;  // where cp was queried, the velocity the solve gave
+            double depth; // m past the contact plane along its normal at the step's end
         };
         std::vector<NewContact> made;
         for (size_t i = 0; i < n; ++i) {
@@ -404,8 +435,19 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                 found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
                         cp.distance < 0.0;
             if (!found) continue;
+            Vec3 at = x1;
+            const ColliderPose& pose = mKin.colliders[k].end;
+            if (pose.shape == ColliderShape::Mesh && !pose.moving && pose.mesh) {
+                // A static mesh: the plane of the face the step's path came in through.
+                ContactPoint entry;
+                Vec3 p;
+                if (pathEntry(*pose.mesh, vec3At(x0.data(), i), x1, thick, p, entry)) {
+                    cp = entry;
+                    at = p;
+                }
+            }
             if (!((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
-            made.push_back({i, cp, x1, v1});
+            made.push_back({i, cp, at, v1, cp.normal.dot(at - x1) - cp.distance + thick});
         }
         // A vertex that ends inside only because an edge neighbour in front of it along the
         // normal (deeper by more than half their rest length: a column of the cloth landing
@@ -419,7 +461,7 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         if (mOptions.deferStackedContacts && !c.moving && made.size() > 1) {
             mDeferDepth.assign(n, -INFINITY); // per vertex, its depth past the contact surface
             for (const NewContact& m : made)
-                mDeferDepth[m.i] = thick - kContactSlop - m.cp.distance;
+                mDeferDepth[m.i] = m.depth;
             for (size_t e = 0; e < mEdges.size(); ++e) {
                 const auto [a, b] = mEdges[e];
                 const double da = mDeferDepth[static_cast<size_t>(a)],
@@ -435,7 +477,7 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             ++changes; // a contact made, or one that waits for another round
             if (!deferred.empty() && deferred[m.i]) continue;
             const size_t i = m.i;
-            setContact(i, ci, m.cp, m.x1, t1, thick, t1, h, x0, v0, m.v1, c.friction > 0.0);
+            setContact(i, ci, m.cp, m.at, t1, thick, t1, h, x0, v0, m.v1, c.friction > 0.0);
             mContactMu[i] = c.friction;
             mContactImpulse[i] = -(m.v1 - m.cp.velocity).dot(m.cp.normal); // the approach it had
             mFoundInside[i] = 1;

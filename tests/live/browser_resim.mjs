@@ -31,6 +31,7 @@ try {
   const logs = [];
   page.on('console', (m) => logs.push(m.text()));
   page.on('pageerror', (e) => logs.push('pageerror: ' + e.message));
+  page.on('response', (r) => { if (r.status() >= 400) logs.push(`${r.status()} ${r.request().method()} ${r.url()}`); });
   await page.goto(url, { waitUntil: 'load' });
   await c.until(() => page.evaluate(() => window.galeLive.ready && window.galeLive.fieldUpdates > 0), 20000, 'the page loads');
   for (const id of ['showSlice', 'showArrows', 'showLines', 'showRigs'])
@@ -132,6 +133,7 @@ try {
   }
   // ---- compare: the run the edit replaced, over the shown frame ----
   await page.click('#simulate'); // Stop, so the shown frame stays put
+  logs.push('clicked Stop: ' + JSON.stringify(await page.evaluate(() => [document.getElementById('simulate').textContent, document.getElementById('simText').textContent, window.galeLive.simLog.length])));
   await c.until(() => page.evaluate(() => /stopped|done/.test(document.getElementById('simText').textContent)), 10000, 'the new run stops');
   // The kept run is the last one an edit replaced after it had stepped (run lastRun − 1, or an
   // earlier one when the slider's last send restarted a run that had not). On a slow machine it may
@@ -182,7 +184,11 @@ try {
   const ended = await page.evaluate(() => window.galeLive.simRun);
   await page.click('#simulate');
   await c.until(() => page.evaluate((r) => window.galeLive.simRun === r + 1 && window.galeLive.framesOfRun >= 6, ended), 20000, 'Simulate then starts a new run, which writes its 6 frames');
-  if (c.failures) console.log(logs.join('\n'));
+  if (c.failures) {
+    console.log(logs.join('\n'));
+    // Each sim event and Simulate press: [kind, the page's run, the button's label, data].
+    console.log((await page.evaluate(() => window.galeLive.simLog)).map((e) => JSON.stringify(e)).join('\n'));
+  }
 } finally {
   await close();
 }
