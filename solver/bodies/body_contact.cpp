@@ -2,7 +2,6 @@
 // by the active set after each solve, Coulomb friction implicit in the solve, cloth held against
 // cloth, and the push-out after the solve (Baraff & Witkin 1998 §5; docs/solver.md, "Contact").
 #include "solver/bodies/body.h"
-#include "solver/collider/mesh_collider.h"
 #include "solver/collider/moving_collider.h"
 
 #include <algorithm>
@@ -29,22 +28,23 @@ constexpr double kProjectionSlop = 1e-6;
 
 namespace {
 
-// Where the path a → b of a vertex first comes within `reach` of a static mesh collider (its
-// SDF, 1-Lipschitz: conservative advancement, each step the distance still to go, a tenth
-// short of it for the trilinear interpolation's slack), in `at` with the query there in `cp`.
-// False when a is within reach already (a vertex that starts inside has only its closest point)
-// or the path never comes that close. A static mesh's closest point to the end of a step can
-// lie on another face than the one the vertex came through: a sheet landing flat on a 24 cm
-// box, its vertices 4 cm into the top and 3.7 cm from a side, was pushed out of the side and up
-// (the top's edges 1.5–1.8× rest at one substep a frame; bench/README.md).
-bool pathEntry(const MeshCollider& mesh, const Vec3& a, const Vec3& b, double reach, Vec3& at,
+// Where the path a → b of a vertex first comes within `reach` of a collider that is not a moving
+// mesh (an analytic shape, or a static mesh's SDF; all 1-Lipschitz distances: conservative
+// advancement, each step the distance still to go, a tenth short of it for the trilinear
+// interpolation's slack), in `at`, with the query there in `cp`. False when a is within reach
+// already (a vertex that starts inside has only its closest point) or the path never comes that
+// close. The closest point to the end of a step can lie on another face than the one the vertex
+// came through: a sheet landing flat on a 24 cm box, its vertices 4 cm into the top and 3.7 cm
+// from a side, was pushed out of the side and up (the top's edges 1.5–1.8× rest at one substep
+// a frame); on a sphere of 10 cm, a vertex 8 cm in was pushed out at its side.
+bool pathEntry(const ColliderPose& pose, const Vec3& a, const Vec3& b, double reach, Vec3& at,
                ContactPoint& cp) {
     const double len = (b - a).norm();
     if (!(len > 0.0)) return false;
     double s = 0.0; // m along the path
     for (int it = 0; it < 64; ++it) {
         at = a + (s / len) * (b - a);
-        mesh.query(at, cp.distance, cp.normal);
+        cp = queryCollider(pose, at);
         const double gap = cp.distance - reach;
         if (!(gap > 0.0)) return it > 0;
         if (gap < 0.02 * reach) return true; // on the surface, to 2 % of the thickness
@@ -437,11 +437,13 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             if (!found) continue;
             Vec3 at = x1;
             const ColliderPose& pose = mKin.colliders[k].end;
-            if (pose.shape == ColliderShape::Mesh && !pose.moving && pose.mesh) {
-                // A static mesh: the plane of the face the step's path came in through.
+            if (!pose.moving) {
+                // The plane of the face the step's path came in through, the path relative to
+                // the collider (its start moved with the surface there to t + h).
                 ContactPoint entry;
                 Vec3 p;
-                if (pathEntry(*pose.mesh, vec3At(x0.data(), i), x1, thick, p, entry)) {
+                const Vec3 a = vec3At(x0.data(), i) + h * cp.velocity;
+                if (pathEntry(pose, a, x1, thick, p, entry)) {
                     cp = entry;
                     at = p;
                 }

@@ -14,7 +14,14 @@
 namespace gale::solver {
 
 namespace {
-constexpr int kMaxIterations = 6;        // Gauss–Newton iterations
+constexpr int kMaxIterations = 6; // Gauss–Newton iterations
+// ... and up to kMaxLateIterations while an edge is still kLateExcess beyond its target. An edge
+// joins the active set only once a neighbour's move has lengthened it, so a chain turning about
+// a contact (a flap over a box's edge, 6 edges long) needs about an iteration per edge: at 6 its
+// outer edge was left 1.45× rest. (Below kLateExcess, the vertices the later iterations move
+// along a curved collider's tangent plane end inside it, for the push-out after the solve.)
+constexpr int kMaxLateIterations = 24;
+constexpr double kLateExcess = 0.02;
 constexpr int kMaxLimitIterations = 30;  // ... with a stretch limit (a bound, not a correction)
 constexpr int kMaxCg = 60;               // CG iterations per Gauss–Newton iteration
 constexpr double kCgTolerance = 1e-3;    // relative residual of each linear solve
@@ -98,7 +105,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     std::vector<int> active;
     std::vector<Vec3> dir, u;
     std::vector<double> c, lambda, r, z, p, q, diag;
-    const int maxIterations = stretchLimit > 0.0 ? kMaxLimitIterations : kMaxIterations;
+    const int maxIterations = stretchLimit > 0.0 ? kMaxLimitIterations : kMaxLateIterations;
     for (int it = 0; it < maxIterations; ++it) {
         active.clear();
         dir.clear();
@@ -106,9 +113,11 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         for (int v : verts) slot[static_cast<size_t>(v)] = -1;
         verts.clear();
         w.clear();
+        double most = 0.0; // the largest relative excess of an active edge
         for (size_t e = 0; e < edges.size(); ++e) {
             const double excess = len[e] - target[e];
             if (!(excess > tolerance * rest[e]) || !(len[e] > 0.0) || !(rest[e] > 0.0)) continue;
+            most = std::max(most, excess / rest[e]);
             const auto [a, b] = edges[e];
             active.push_back(static_cast<int>(e));
             dir.push_back((at(x, b) - at(x, a)) / len[e]);
@@ -121,6 +130,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
                 }
         }
         if (active.empty()) break;
+        if (it >= kMaxIterations && stretchLimit <= 0.0 && !(most > kLateExcess)) break;
         u.resize(verts.size());
         ++stats.iterations;
         const size_t m = active.size();
