@@ -720,24 +720,10 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
         }
         return normal;
     };
-    // A sticking contact may move in its plane here. The solve stuck it where its own path met
-    // the surface, and where a whole sheet lands within the step each vertex lands along its own
-    // path: a flat sheet falling onto a 17° slope ended with its edges 1/cos θ long (4.4 %) where
-    // at fine steps it rolls onto the slope about its first contact. Pins and attachments stay.
-    const Constraints* held = &mConstraints;
-    Constraints sliding;
-    for (size_t i = 0; i < vertexCount(); ++i)
-        if (mConstraints.kind[i] == 1 && mContactCollider[i] >= 0) {
-            if (held == &mConstraints) {
-                sliding = mConstraints;
-                held = &sliding;
-            }
-            sliding.kind[i] = 2;
-        }
     const VecX dvBefore = mDv;
     const RotationProjectionStats ps =
-        projectRotationLength(mEdges, mEdgeRest, mMass, *held, x0, v0, mYPos, h, mDv, tolerance,
-                              hold, rotations, stretchLimit);
+        projectRotationLength(mEdges, mEdgeRest, mMass, mConstraints, x0, v0, mYPos, h, mDv,
+                              tolerance, hold, rotations, stretchLimit);
     // Every vertex it moved that a collider's surface came closer to (a curved one under a
     // contact sliding in its plane, or under a vertex moving in the tangent plane of its
     // nearest point): back out along the normal to the distance it had, or to the thickness.
