@@ -190,11 +190,11 @@ TEST_CASE("hard: gossamer flag 3 degrees off edge-on takes one substep per frame
 
 TEST_CASE("hard: the gossamer flag at one substep a frame stays within a stretch limit", "[hard]") {
     // The same flag with a [solver] stretch_limit it passes without one (with the defaults —
-    // the rotation projection, the bounded aero Jacobian — 1.07 at 20 m/s and 1.35 at 40; 1.26
-    // and 1.88 with the projection's first 6 iterations only; 1.46 and 1.90 with the projected
-    // Jacobian; 2.9 at 20 m/s without the projection either, bench/README.md): no frame ends
-    // with an edge beyond it.
-    for (const auto& [U, cap] : {std::pair{20.0, 1.06}, std::pair{40.0, 1.2}}) {
+    // the rotation projection, the bounded aero Jacobian — 1.35 at 20 m/s and 1.85 at 40, 1.07
+    // and 1.35 were the projection's later iterations to go on for every edge beyond 2 %; 1.46
+    // and 1.90 with the projected Jacobian; 2.9 at 20 m/s without the projection either,
+    // bench/README.md): no frame ends with an edge beyond it.
+    for (const auto& [U, cap] : {std::pair{20.0, 1.15}, std::pair{40.0, 1.5}}) {
         FlagSetup s = offEdgeOn(U);
         const FlagRun free = runFlag(s);
         s.stretchLimit = cap;
