@@ -15,6 +15,15 @@ async function api(path, body) {
   return j;
 }
 
+// The run's status beside Simulate, in a box of fixed width (style.css) so that the button does
+// not move as the text changes (a press as a run ended landed beside it); the whole text as its
+// tooltip.
+function simStatus(text) {
+    const e = $('simText');
+    e.textContent = text;
+    e.title = text;
+}
+
 const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null, simFramesDrawn: [], colliderTimes: [] });
 const view = new View($('view'));
 live.screenBox = (name) => view.screenBox(name);
@@ -278,7 +287,7 @@ function events() {
     if (d.run !== undefined && d.run !== simRun) return; // a frame of a run that was replaced
     simFrames.push(f);
     timeline.simFrames = simFrames;
-    $('simText').textContent = `frame ${f} of ${state.frames[1]}` + (simRun > 1 ? ` (run ${simRun})` : '');
+    simStatus(`frame ${f} of ${state.frames[1]}` + (simRun > 1 ? ` (run ${simRun})` : ''));
     live.framesOfRun = simFrames.length;
     if (!playing) setTime(frameTime(f));
     refreshRun();
@@ -306,7 +315,10 @@ function events() {
     $('simulate').textContent = s.running || s.on ? 'Stop' : 'Simulate';
     if (!s.running) {
       endedRun = s.run;
-      $('simText').textContent = s.exit === 0 ? `done: ${simFrames.length} frames` : s.exit === -1 ? 'stopped' : `gale sim failed (exit ${s.exit}): ` + (s.log || '').trim().split('\n').pop();
+      simStatus(s.exit === 0 ? `done: ${simFrames.length} frames`
+                : s.exit === -1 ? 'stopped'
+                                : `gale sim failed (exit ${s.exit}): ` +
+                                      (s.log || '').trim().split('\n').pop());
       refreshRun();
     }
   });
@@ -347,10 +359,10 @@ function wire() {
       // leaves it on, and edits re-simulate), so a Stop after the run's end turns it off.
       $('simulate').textContent = r.running || r.on ? 'Stop' : 'Simulate';
       // (A short run may have ended, and its event been shown, before this reply.)
-      if (r.run !== endedRun) $('simText').textContent = r.running ? 'simulating…' : '';
+      if (r.run !== endedRun) simStatus(r.running ? 'simulating…' : '');
     } catch (e) {
       live.simLog.push(['press failed', simRun, String(e.message || e)]);
-      $('simText').textContent = String(e.message || e);
+      simStatus(String(e.message || e));
     }
   };
   $('showStrain').onchange = () => drawSimFrame();

@@ -25,6 +25,15 @@ const hot = (px) => {
   for (let i = 0; i < px.length; i += 3) if (px[i] > 60 && px[i] > 1.6 * px[i + 1] && px[i] > 1.6 * px[i + 2]) n++;
   return n;
 };
+// Presses Simulate / Stop and waits (up to 10 s) for the server's reply to reach the page, so
+// that what follows sees the state the press made (the page logs each press in galeLive.simLog).
+const pressSimulate = async (page) => {
+  const presses = () => page.evaluate(() => window.galeLive.simLog.filter((e) => e[0].startsWith('press')).length);
+  const before = await presses();
+  await page.click('#simulate');
+  for (let t = 0; t < 200 && (await presses()) === before; t++) await sleep(50);
+  if ((await presses()) === before) c.check(false, 'a press of Simulate reaches the server');
+};
 try {
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 800 });
@@ -38,10 +47,10 @@ try {
     await page.evaluate((id) => { const e = document.getElementById(id); if (e.checked) e.click(); }, id);
 
   // ---- strain colours on a run's frame ----
-  await page.click('#simulate');
+  await pressSimulate(page);
   await c.until(() => page.evaluate(() => window.galeLive.simRun === 1 && window.galeLive.framesOfRun >= 12), 30000,
     'the first run reaches frame 12');
-  await page.click('#simulate'); // Stop: the frames stay, the page stops following new ones
+  await pressSimulate(page); // Stop: the frames stay, the page stops following new ones
   await c.until(() => page.evaluate(() => /stopped|done/.test(document.getElementById('simText').textContent)), 10000, 'the run stops');
   const f12 = await frameOf(page, 12);
   const sheet = f12 && f12.objects.find((o) => o.label === 'sheet');
@@ -82,7 +91,7 @@ try {
   if (run) c.check(run.frames.every((f) => Number.isFinite(f.maxStretch) && Array.isArray(f.events)), `${run.frames.length} frames of run.json on the timeline, status ${run.status}`);
 
   // ---- a slider edit during the simulation restarts it ----
-  await page.click('#simulate'); // Simulate again (run 2), and edit while it runs
+  await pressSimulate(page); // Simulate again (run 2), and edit while it runs
   await c.until(() => page.evaluate(() => window.galeLive.simRun === 2 && window.galeLive.framesOfRun >= 3), 30000,
     'the second run reaches frame 3');
   const oldRun = await c.until(() => frameOf(page, 3), 5000, 'frame 3 of the run before the edit');
@@ -132,8 +141,7 @@ try {
     fs.rmSync(out, { recursive: true, force: true });
   }
   // ---- compare: the run the edit replaced, over the shown frame ----
-  await page.click('#simulate'); // Stop, so the shown frame stays put
-  logs.push('clicked Stop: ' + JSON.stringify(await page.evaluate(() => [document.getElementById('simulate').textContent, document.getElementById('simText').textContent, window.galeLive.simLog.length])));
+  await pressSimulate(page); // Stop, so the shown frame stays put
   await c.until(() => page.evaluate(() => /stopped|done/.test(document.getElementById('simText').textContent)), 10000, 'the new run stops');
   // The kept run is the last one an edit replaced after it had stepped (run lastRun − 1, or an
   // earlier one when the slider's last send restarted a run that had not). On a slow machine it may
@@ -177,12 +185,12 @@ try {
     return r.ok && (await r.json()).frames[1] === 6;
   }), 10000, 'the page sees the scene\'s new frame range');
   const before6 = await page.evaluate(() => window.galeLive.simRun);
-  await page.click('#simulate');
+  await pressSimulate(page);
   await c.until(() => page.evaluate((r) => window.galeLive.simRun > r && /done/.test(document.getElementById('simText').textContent), before6), 20000, 'a 6-frame run ends by itself');
-  await page.click('#simulate'); // Stop (edits no longer re-simulate)
+  await pressSimulate(page); // Stop (edits no longer re-simulate)
   await c.until(() => page.evaluate(() => document.getElementById('simulate').textContent === 'Simulate'), 5000, 'Stop after the run\'s end turns the button back to Simulate');
   const ended = await page.evaluate(() => window.galeLive.simRun);
-  await page.click('#simulate');
+  await pressSimulate(page);
   await c.until(() => page.evaluate((r) => window.galeLive.simRun === r + 1 && window.galeLive.framesOfRun >= 6, ended), 20000, 'Simulate then starts a new run, which writes its 6 frames');
   if (c.failures) {
     console.log(logs.join('\n'));
