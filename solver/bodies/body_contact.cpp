@@ -24,9 +24,6 @@ constexpr double kFrictionChange = 0.01;
 constexpr double kSlipFloor = 1e-3;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
-} // namespace
-
-namespace {
 
 // Where the path a → b of a vertex first comes within `reach` of a collider that is not a moving
 // mesh (an analytic shape, or a static mesh's SDF; all 1-Lipschitz distances: conservative

@@ -22,7 +22,7 @@ constexpr int kMaxIterations = 6; // Gauss–Newton iterations
 // (Below kLateExcess, the vertices the later iterations move along a curved collider's tangent
 // plane end inside it, for the push-out after the solve; in free air, at a tolerance of 3 %, the
 // later iterations for every edge beyond 3 % cost the wind-onset flag 25–35 % of its median
-// frame, against 1–4 % for those beyond 15 %, which still brought its stretch 1.40 → 1.19.)
+// frame; for those beyond 15 % the cost is within the noise, and its stretch still 1.40 → 1.19.)
 constexpr int kMaxLateIterations = 24;
 constexpr double kLateExcess = 0.02;
 constexpr double kLateTolerances = 5.0;
