@@ -19,9 +19,9 @@ async function api(path, body) {
 // not move as the text changes (a press as a run ended landed beside it); the whole text as its
 // tooltip.
 function simStatus(text) {
-    const e = $('simText');
-    e.textContent = text;
-    e.title = text;
+  const e = $('simText');
+  e.textContent = text;
+  e.title = text;
 }
 
 const live = (window.galeLive = { fieldUpdates: 0, stateUpdates: 0, errors: [], ready: false, simFrameShown: null, colliderTime: null, simFramesDrawn: [], colliderTimes: [] });
@@ -315,10 +315,7 @@ function events() {
     $('simulate').textContent = s.running || s.on ? 'Stop' : 'Simulate';
     if (!s.running) {
       endedRun = s.run;
-      simStatus(s.exit === 0 ? `done: ${simFrames.length} frames`
-                : s.exit === -1 ? 'stopped'
-                                : `gale sim failed (exit ${s.exit}): ` +
-                                      (s.log || '').trim().split('\n').pop());
+      simStatus(s.exit === 0 ? `done: ${simFrames.length} frames` : s.exit === -1 ? 'stopped' : `gale sim failed (exit ${s.exit}): ` + (s.log || '').trim().split('\n').pop());
       refreshRun();
     }
   });
