@@ -108,6 +108,9 @@ void Loader::applySets(toml::table& root, const std::vector<std::string>& sets) 
 
 // ---- values -----------------------------------------------------------------------------------
 
+// attach.stiffness's largest value (N/m per vertex; see its reader).
+constexpr double kMaxAttachStiffness = 1e12;
+
 bool Loader::number(const toml::node& n, const std::string& what, double& out, double min, bool strictMin) {
     if (!isTomlNumber(n)) {
         error(n, what + " must be a number, not " + tomlTypeName(n));
@@ -348,10 +351,18 @@ bool Loader::attach(const toml::node& n, const std::string& what, const std::str
         ok = false;
     }
     // stiffness (N/m per vertex): a soft attachment, a zero-length spring to the bound point.
-    if (const toml::node* k = t->get("stiffness"))
-        ok = number(*k, what + ": stiffness (N/m per vertex; leave it out for a hard attachment)",
-                    out.stiffness, 0.0, true) &&
-             ok;
+    if (const toml::node* k = t->get("stiffness")) {
+        // Above 10¹² N/m a spring differs from the hard attachment by nothing but rounding (and
+        // h²k would leave the solver's single-precision range): leave the key out for that.
+        const bool read =
+            number(*k, what + ": stiffness (N/m per vertex; leave it out for a hard attachment)",
+                   out.stiffness, 0.0, true);
+        if (read && out.stiffness > kMaxAttachStiffness)
+            error(*k, what + ": stiffness " + io::formatNumber(out.stiffness) +
+                          " N/m is beyond 1e12: a spring that stiff is a hard attachment; leave "
+                          "stiffness out for one");
+        ok = read && out.stiffness <= kMaxAttachStiffness && ok;
+    }
     if (!t->get("vertices") && !t->get("map") && !t->get("box")) {
         checkKeys(*t, {"mesh", "vertices", "map", "box", "stiffness"}, what);
         if (needSelection) {

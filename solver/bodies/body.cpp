@@ -240,6 +240,7 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     addForces(in, out);
     addSoftAttachments(in, out, matrix);
     if (matrix) {
+        mAssembledH = in.h;
         mSkewed = out.skewed;
         mAeroPosition = in.aeroPosition && !mAero.empty();
     }
@@ -324,6 +325,23 @@ double Body::aeroQuadratic(const VecX& x) const {
 // moderate. Started from the symmetric solution; if it does not reach the tolerance the step
 // keeps the symmetric solve (the skew part explicit, as it was before) and counts a fallback.
 SolveStatus Body::solveLinear(const VecX& b, VecX& dv) {
+    // A soft attachment stiff enough to own its row's diagonal (h²k ≫ the mass and the cloth's
+    // own stiffness there) would own ‖rhs‖ too (its h k d grows with k): PCG is told to weigh
+    // that row by its diagonal's share without the spring, w = d/(d + h²k) — the residual as the
+    // velocity error it stands for, D⁻¹r, relative to the other rows' — so that it stops on the
+    // whole cloth's residual (a 10⁷ N/m attachment otherwise left the cape at 3× rest). Rows
+    // without a spring weigh 1: a body without soft attachments solves exactly as before.
+    if (!mSoft.empty()) {
+        std::vector<double> w(vertexCount(), 1.0);
+        const double h2 = mAssembledH * mAssembledH;
+        for (const SoftAttachment& s : mSoft) {
+            const double spring = h2 * mPinSets[s.set].stiffness;
+            const double total = mA.block(mA.diagonalSlot(s.vertex)).trace() / 3.0;
+            const double own = std::max(total - spring, 1e-12 * total);
+            if (total > 0.0 && std::isfinite(total)) w[s.vertex] = own / total;
+        }
+        mSolver.setResidualWeights(std::move(w));
+    }
     SolveStatus ls = mSolver.solve(mA, mConstraints, b, dv, mOptions.linearSolver,
                                    mOptions.cgTolerance, mOptions.cgMaxIterations);
     if (!(mSkewed || mAeroPosition) || !ls.converged || ls.failed) return ls;

@@ -429,6 +429,7 @@ private:
         std::shared_ptr<const SurfaceBinding> binding;
     };
     std::vector<SoftAttachment> mSoft;
+    double mAssembledH = 0.0; // the step of the last assembled matrix (its springs' h²k)
     // Adds the soft attachments' springs to forces, K v, A and the elastic energy, targets at
     // in.t + in.h (after addForces, wherever it is called).
     void addSoftAttachments(const ForceInput& in, ForceOutput& out, bool matrix) const;

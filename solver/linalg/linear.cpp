@@ -204,6 +204,13 @@ SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, co
     return st;
 }
 
+double FilteredSolver::residualNorm(const VecX& r) {
+    const size_t n3 = static_cast<size_t>(r.size());
+    if (mW2.size() == 0) return std::sqrt(deterministicDot(r.data(), r.data(), n3));
+    mWr = mW2.cwiseProduct(r); // rᵀ(w² r)
+    return std::sqrt(deterministicDot(mWr.data(), r.data(), n3));
+}
+
 SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c, const VecX& rhs,
                                      VecX& y, double tolerance, int maxIterations) {
     SolveStatus st;
@@ -225,7 +232,13 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
                 out.segment<3>(3 * i).noalias() = mPrecond[i] * r.segment<3>(3 * i);
         });
     };
-    const double rhsNorm = std::sqrt(deterministicDot(rhs.data(), rhs.data(), n3));
+    mW2.resize(0);
+    if (!mWeights.empty()) {
+        mW2.resize(static_cast<long>(n3));
+        for (size_t k = 0; k < n3; ++k)
+            mW2[static_cast<long>(k)] = mWeights[k / 3] * mWeights[k / 3];
+    }
+    const double rhsNorm = residualNorm(rhs);
     if (trivialRhs(rhsNorm, y, st)) return st;
     mR.resize(n3);
     mZ.resize(n3);
@@ -233,7 +246,7 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
     mQ.resize(n3);
     applyFiltered(A, c, y, mQ);
     mR = rhs - mQ;
-    double rNorm = std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+    double rNorm = residualNorm(mR);
     const double target = std::max(tolerance * rhsNorm, mResidualFloor);
     if (rNorm <= target) {
         st.converged = true;
@@ -273,7 +286,9 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
                     mZ[k] = z0;
                     mZ[k + 1] = z1;
                     mZ[k + 2] = z2;
-                    rr += r0 * r0 + r1 * r1 + r2 * r2;
+                    rr += mW2.size() == 0
+                              ? r0 * r0 + r1 * r1 + r2 * r2
+                              : mW2[k] * r0 * r0 + mW2[k + 1] * r1 * r1 + mW2[k + 2] * r2 * r2;
                     rzp += r0 * z0 + r1 * z1 + r2 * z2;
                 }
                 mPartial[2 * ch] = rr;
@@ -324,10 +339,18 @@ double FilteredSolver::multigridCg(VecX& y, double rNorm, double target, bool si
             for (size_t ch = c0; ch < c1; ++ch) {
                 const size_t b = ch * kReduceChunk, e = std::min(n3, b + kReduceChunk);
                 double rr = 0.0;
-                for (size_t k = b; k < e; ++k) {
-                    y[k] += alpha * mP[k];
-                    mR[k] -= alpha * mQ[k];
-                    rr += mR[k] * mR[k];
+                if (mW2.size() == 0) {
+                    for (size_t k = b; k < e; ++k) {
+                        y[k] += alpha * mP[k];
+                        mR[k] -= alpha * mQ[k];
+                        rr += mR[k] * mR[k];
+                    }
+                } else {
+                    for (size_t k = b; k < e; ++k) {
+                        y[k] += alpha * mP[k];
+                        mR[k] -= alpha * mQ[k];
+                        rr += mW2[k] * mR[k] * mR[k];
+                    }
                 }
                 mPartial[ch] = rr;
             }
@@ -365,11 +388,21 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
                                               double tolerance, int maxIterations) {
     SolveStatus st;
     const size_t n3 = 3 * static_cast<size_t>(A.size());
-    const double rhsNorm = std::sqrt(deterministicDot(rhsNatural.data(), rhsNatural.data(), n3));
+    mW2.resize(0);
+    if (!mWeights.empty()) {
+        mW2.resize(static_cast<long>(n3));
+        for (size_t k = 0; k < n3; ++k)
+            mW2[static_cast<long>(k)] = mWeights[k / 3] * mWeights[k / 3];
+    }
+    const double rhsNorm = residualNorm(rhsNatural);
     if (trivialRhs(rhsNorm, yNatural, st)) return st;
     if (!mMultigrid.refresh(A, c, mConstrained, mKeepCoarse)) {
         st.failed = true;
         return st;
+    }
+    if (mW2.size() != 0) { // the weights in level order, as CG runs
+        VecX natural = mW2;
+        mMultigrid.toLevelOrder(natural.data(), mW2.data());
     }
     mR.resize(n3);
     mZ.resize(n3);
@@ -388,7 +421,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
         if (single) mMultigrid.multiplyDot(y.data(), mQ.data(), true);
         else mMultigrid.multiply(y.data(), mQ.data());
         mR = rhs - mQ;
-        return std::sqrt(deterministicDot(mR.data(), mR.data(), n3));
+        return residualNorm(mR);
     };
     const bool single = tolerance >= kSinglePrecisionTolerance;
     double rNorm = residual(single);

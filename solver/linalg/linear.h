@@ -132,6 +132,11 @@ public:
     // below which the residual is physically nothing (Body: a tenth of the tolerance of
     // gravity's impulse over the step). 0: relative only.
     void setResidualFloor(double floor) { mResidualFloor = floor; }
+    // PCG measures ‖W r‖ against tolerance ‖W rhs‖, W = diag(w) per block row (empty: W = I).
+    // A row whose diagonal a stiff term (a soft attachment's h²k) makes 10³× its neighbours'
+    // would otherwise own ‖rhs‖, and PCG would stop with the rest of the cloth unsolved: Body
+    // gives such rows w = d/(d + h²k), d the row's diagonal without the spring.
+    void setResidualWeights(std::vector<double> w) { mWeights = std::move(w); }
 
     SolveStatus solve(const BlockMatrix& A, const Constraints& c, const VecX& b, VecX& dv,
                       LinearSolverKind kind, double tolerance, int maxIterations);
@@ -149,6 +154,10 @@ private:
     Preconditioner mPreconditioner = Preconditioner::BlockJacobi;
     bool mKeepCoarse = false;
     double mResidualFloor = 0.0;
+    std::vector<double> mWeights; // per block row, natural order (setResidualWeights)
+    VecX mW2, mWr;                // w² per row component, in the order the solve runs in; w² r
+    // ‖r‖ or, with weights, ‖W r‖ (mW2 set up for the solve's order).
+    double residualNorm(const VecX& r);
     BlockMultigrid mMultigrid;
     VecX mTmp2, mR, mZ, mP, mQ;
     VecX mRhsLevel, mYLevel; // multigrid PCG's rhs and y in the multigrid's level-0 order
