@@ -145,6 +145,11 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         const fs::file_status st = fs::status(p, ec);
         if (ec || !fs::exists(st)) {
             error = "cannot read '" + name + "' (" + resolved + "): " + std::strerror(ENOENT);
+            // Another program's frame token (${F4}, @, %-4d, <f>): say which ones gale reads.
+            if (file.find_first_of("%@<") != std::string::npos ||
+                file.find('$') != std::string::npos)
+                error += std::string("; if it names a frame sequence, write the frame number as ") +
+                         io::kFrameTokens;
             return false;
         }
         if (fs::is_directory(st)) {
@@ -177,6 +182,14 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         long frame = 0;
         if (!io::matchFrame(pattern, entry, frame)) continue; // another name, or other padding
         std::error_code sec;
+        if (fs::is_symlink(it->symlink_status(sec)) && !fs::exists(it->path(), sec)) {
+            // A frame linked into a cache that is not there (an unmounted volume): said, not
+            // skipped (the body would stand still where the frames are missing).
+            error = "frame file '" + entry + "' of '" + name + "' is a link to " +
+                    fs::read_symlink(it->path(), sec).string() +
+                    ", which does not exist (is its volume mounted?)";
+            return false;
+        }
         if (!fs::is_regular_file(it->path(), sec)) continue;
         const fs::path canonical = canonicalOf(it->path());
         if (!permitted(access, canonical, fs::path(name).is_absolute())) {

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <istream>
+#include <limits>
 #include <ostream>
 #include <set>
 #include <string_view>
@@ -282,12 +283,54 @@ IoError readPointsCsv(std::istream& in, const std::string& displayName, PointSet
 
 // ---- OBJ ----
 
+namespace {
+// tinyobjloader reads a coordinate it cannot parse ("abc", "1,5", "nan") as 0, a missing one as 0
+// too, and one beyond single precision (its real_t) as ∞: a mesh would silently collapse or
+// blow up. Every `v` line is checked here first: x, y and z present, numbers, finite, within
+// float range; the first bad one is an error at its line and column.
+IoError checkObjVertices(const std::string& path, std::istream& in) {
+    std::string line;
+    int lineNo = 0;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        size_t p = line.find_first_not_of(" \t");
+        if (p == std::string::npos || line[p] != 'v' || p + 1 >= line.size() ||
+            (line[p + 1] != ' ' && line[p + 1] != '\t'))
+            continue;
+        p += 1;
+        for (int k = 0; k < 3; ++k) {
+            p = line.find_first_not_of(" \t\r", p);
+            if (p == std::string::npos || line[p] == '#')
+                return dataError(path, lineNo, static_cast<int>(std::min(p, line.size()) + 1),
+                                 "a vertex needs x, y and z, this one has " + std::to_string(k) +
+                                     ": fix its v line");
+            const size_t end = std::min(line.find_first_of(" \t\r", p), line.size());
+            const std::string_view token(line.data() + p, end - p);
+            double v = 0.0;
+            std::string bad = parseNumber(token, v);
+            if (bad.empty() && !std::isfinite(v))
+                bad = "a vertex coordinate must be finite, not '" + std::string(token) + "'";
+            else if (bad.empty() && std::abs(v) > std::numeric_limits<float>::max())
+                bad = "'" + std::string(token) +
+                      "' is beyond single precision (OBJ vertices are read as floats)";
+            if (!bad.empty())
+                return dataError(path, lineNo, static_cast<int>(p + 1),
+                                 "vertex " + std::string(1, "xyz"[k]) + ": " + bad);
+            p = end;
+        }
+    }
+    if (in.bad()) return ioError(path, "read failed: " + errnoText(errno));
+    return {};
+}
+} // namespace
+
 IoError readPointsObj(const std::string& path, PointSet& out) {
     out = PointSet{};
     {
         errno = 0;
         std::ifstream probe(path);
         if (!probe) return ioError(path, "cannot open: " + errnoText(errno));
+        if (IoError e = checkObjVertices(path, probe)) return e;
     }
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;

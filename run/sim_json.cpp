@@ -159,8 +159,9 @@ std::string frameJson(const solver::FrameStats& f) {
           << "}, \"wind_non_finite\": " << b.windNonFinite
           << ", \"clamped_jacobians\": " << b.clampedJacobians << ", \"contacts\": " << b.contacts
           << ", \"contact_solve\": {\"constraints\": " << b.contactConstraints
-          << ", \"added\": " << b.contactAdded << ", \"released\": " << b.contactReleases
-          << ", \"slid\": " << b.contactSlides << ", \"extra_solves\": " << b.contactSolves
+          << ", \"added\": " << b.contactAdded << ", \"through\": " << b.contactsThrough
+          << ", \"released\": " << b.contactReleases << ", \"slid\": " << b.contactSlides
+          << ", \"extra_solves\": " << b.contactSolves
           << "}, \"rotation_projection\": {\"substeps\": " << b.rotationSubsteps
           << ", \"edges\": " << b.rotationEdges << ", \"max_excess\": " << num(b.rotationExcess)
           << "}, \"stretch_limit\": {\"substeps\": " << b.stretchLimitSubsteps

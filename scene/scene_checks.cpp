@@ -1,6 +1,8 @@
 // Run warnings of a scene (scene_checks.h): sequence coverage, units and reach of colliders.
 #include "scene/scene_checks.h"
 
+#include "io/frame_pattern.h"
+
 #include "solver/collider/moving_collider.h"
 #include "solver/world/frame_trouble.h"
 #include "solver/world/self_collision.h"
@@ -8,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <string>
 
@@ -92,16 +95,48 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     Box cloth;
     double clothExtent = 0.0;
     std::vector<Box> bodyBoxes;
+    std::vector<std::pair<int, solver::Vec3>> bound;
     for (const auto& b : bodies) {
         std::vector<double> x(b->positions().data(), b->positions().data() + b->positions().size());
         bodyBoxes.push_back(boxOf(x));
-        cloth.add(bodyBoxes.back());
         clothExtent = std::max(clothExtent, bodyBoxes.back().extent());
+        // Attached cloth is where its body is at the first frame (a cape modelled on the rest
+        // pose, carried there by the pre-roll): a body it is attached to is near it.
+        b->attachmentTargets(s.frameTime(first), bound);
+        for (const auto& [v, p] : bound) bodyBoxes.back().add(p);
+        cloth.add(bodyBoxes.back());
+    }
+    // A selection that holds nothing (a box beside the cloth, a map that is zero everywhere).
+    const auto warnAt = [&](int line, int col, std::string message) {
+        SceneError e = sceneErrorAt(scene.wind.path, line, col, std::move(message));
+        e.warning = true;
+        out.push_back(std::move(e));
+    };
+    const auto heldBy = [](const solver::Body& body, bool attachments) {
+        size_t n = 0;
+        for (const solver::PinSet& set : body.pinSets())
+            if ((set.attach != nullptr) == attachments) n += set.vertices.size();
+        return n;
+    };
+    for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
+        const ClothSpec& spec = scene.cloths[i];
+        const std::string what = "[[cloth]] '" + spec.name + "'";
+        if (spec.hasPins && heldBy(*bodies[i], false) == 0)
+            warnAt(spec.pins.line, spec.pins.col,
+                   what + " pins: they select no vertex: check the box, vertices or map");
+        if (spec.hasAttach && heldBy(*bodies[i], true) == 0)
+            warnAt(spec.attach.line, spec.attach.col,
+                   what + " attach: it selects no vertex: check the box, vertices or map");
+    }
+    for (size_t j = 0; j < scene.hairs.size() && scene.cloths.size() + j < bodies.size(); ++j) {
+        const HairSpec& spec = scene.hairs[j];
+        if (spec.hasAttach && heldBy(*bodies[scene.cloths.size() + j], true) == 0)
+            warnAt(spec.attach.line, spec.attach.col,
+                   "[[hair]] '" + spec.name + "' attach: it selects no root: check the box");
     }
     // Attached edges (both ends bound to a body's surface) that the body's motion stretches or
     // compresses past kBindingLimit over the run's frames: the cloth there cannot do better than
     // the skin (hard) or fights it (soft).
-    std::vector<std::pair<int, solver::Vec3>> bound;
     for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
         const ClothSpec& spec = scene.cloths[i];
         const solver::Body& body = *bodies[i];
@@ -260,34 +295,73 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                                                                       : "a",
                              jump, at));
     }
+    // A sequence that ends before the run (or starts after it), or whose frame pattern matched
+    // one file: the body stands still there. (Loaded with the scene's fps and time_zero: its
+    // frame numbers are the run's.)
+    const auto checkSequence = [&](const solver::MeshSequence& seq, int line, int col,
+                                   const std::string& what) {
+        io::FramePattern fp;
+        if (!io::parseFramePattern(std::filesystem::path(seq.path()).filename().string(), fp))
+            return;
+        if (seq.lastFrame() == seq.firstFrame() && last > first)
+            warnAt(line, col,
+                   what + ": its mesh sequence '" + seq.path() + "' matches one file (frame " +
+                       std::to_string(seq.firstFrame()) +
+                       "), so the body stands still over the run (frames " + std::to_string(first) +
+                       " to " + std::to_string(last) +
+                       "): write the other frames, or name the file without a frame token");
+        else if (last > seq.lastFrame() || first < seq.firstFrame())
+            warnAt(line, col,
+                   what + ": its mesh sequence '" + seq.path() + "' has frames " +
+                       std::to_string(seq.firstFrame()) + "-" + std::to_string(seq.lastFrame()) +
+                       " but the run goes from frame " + std::to_string(first) + " to " +
+                       std::to_string(last) +
+                       ": outside its frames the body holds its first or last pose (write the "
+                       "frames, or shorten the run)");
+    };
+    // A body in centimetres (or cloth in them): extents 25× apart.
+    const auto checkScale = [&](double extent, int line, int col, const std::string& what) {
+        if (cloth.empty() || !(clothExtent > 0.0) || !(extent > 0.0)) return;
+        if (extent > 25.0 * clothExtent)
+            warnAt(line, col,
+                   what + " is " + metres(extent) + " m across, " + metres(extent / clothExtent) +
+                       "x the largest cloth or hair (" + metres(clothExtent) +
+                       " m): modelled in centimetres? gale's units are metres (export at a scale "
+                       "of 0.01)");
+        else if (25.0 * extent < clothExtent)
+            warnAt(line, col,
+                   what + " is " + metres(extent) + " m across, 1/" + metres(clothExtent / extent) +
+                       " of the largest cloth or hair (" + metres(clothExtent) +
+                       " m): is the cloth in centimetres? gale's units are metres");
+    };
+    // Bodies named only by attachments get the same checks (a collider's are below).
+    std::vector<const solver::MeshSequence*> checked;
+    for (const solver::Collider& c : scene.colliders)
+        if (c.moving) checked.push_back(&c.moving->mesh());
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        const bool isCloth = i < scene.cloths.size();
+        if (!isCloth && i - scene.cloths.size() >= scene.hairs.size()) break;
+        const PinSpec& spec =
+            isCloth ? scene.cloths[i].attach : scene.hairs[i - scene.cloths.size()].attach;
+        const std::string what =
+            (isCloth ? "[[cloth]] '" + scene.cloths[i].name
+                     : "[[hair]] '" + scene.hairs[i - scene.cloths.size()].name) +
+            "' attach";
+        for (const solver::PinSet& set : bodies[i]->pinSets()) {
+            const solver::MeshSequence* seq = set.attach.get();
+            if (!seq || std::find(checked.begin(), checked.end(), seq) != checked.end()) continue;
+            checked.push_back(seq);
+            checkSequence(*seq, spec.line, spec.col, what);
+            checkScale(boxOf(seq->firstPositions()).extent(), spec.line, spec.col,
+                       what + ": its body");
+        }
+    }
     for (const solver::Collider& c : scene.colliders) {
         const std::string what = "[[collider]] '" + c.name + "'";
-        // A sequence that ends before the run (or starts after it): the body stands still there.
-        if (c.moving && c.moving->mesh().moving()) {
-            // The sequence was loaded with the scene's fps and time_zero: its frame numbers are
-            // the run's.
-            const solver::MeshSequence& seq = c.moving->mesh();
-            if (last > seq.lastFrame() || first < seq.firstFrame())
-                warn(c, what + ": its mesh sequence '" + seq.path() + "' has frames " +
-                            std::to_string(seq.firstFrame()) + "-" +
-                            std::to_string(seq.lastFrame()) + " but the run goes from frame " +
-                            std::to_string(first) + " to " + std::to_string(last) +
-                            ": outside its frames the body holds its first or "
-                            "last pose (write the frames, or shorten the run)");
-        }
+        if (c.moving) checkSequence(c.moving->mesh(), c.line, c.col, what);
         const Box box = colliderBox(c, s.frameTime(first));
         if (box.empty() || cloth.empty() || !(clothExtent > 0.0)) continue;
-        const double extent = box.extent();
-        if (extent > 25.0 * clothExtent)
-            warn(c, what + " is " + metres(extent) + " m across, " + metres(extent / clothExtent) +
-                        "x the largest cloth or hair (" + metres(clothExtent) +
-                        " m): modelled in centimetres? gale's units are metres (export at a scale "
-                        "of 0.01)");
-        else if (25.0 * extent < clothExtent)
-            warn(c, what + " is " + metres(extent) + " m across, 1/" +
-                        metres(clothExtent / extent) + " of the largest cloth or hair (" +
-                        metres(clothExtent) +
-                        " m): is the cloth in centimetres? gale's units are metres");
+        checkScale(box.extent(), c.line, c.col, what);
         double nearest = std::numeric_limits<double>::infinity();
         for (const Box& b : bodyBoxes) nearest = std::min(nearest, box.gap(b));
         const double reach = std::max(1.0, 2.0 * clothExtent);

@@ -207,13 +207,19 @@ std::shared_ptr<const MeshSequence> loadSequence(const std::string& path,
     return s;
 }
 
-// One key for the spellings of one sequence (`body.#.obj`, `body.%04d.obj`, `body.$F4.obj`).
+// One key for the spellings of one sequence (`body.#.obj`, `body.%04d.obj`, `body.$F4.obj`,
+// and `body.$F.obj` or `%d` for frames of four digits; its folder relative or absolute, through
+// links or not): the folder's canonical path and the name around the frame token. (Two
+// sequences that differ only in their padding, body.7.obj and body.0007.obj, would share one:
+// not a layout anyone writes.)
 std::string sequenceKey(const std::string& path) {
-    const std::filesystem::path p = std::filesystem::path(path).lexically_normal();
+    std::filesystem::path p = std::filesystem::path(path).lexically_normal();
+    std::error_code ec;
+    const std::filesystem::path dir = std::filesystem::weakly_canonical(p.parent_path(), ec);
+    if (!ec && !dir.empty()) p = dir / p.filename();
     io::FramePattern fp;
     if (!io::parseFramePattern(p.filename().string(), fp)) return p.string();
-    return (p.parent_path() / (fp.prefix + "<" + std::to_string(fp.width) + ">" + fp.suffix))
-        .string();
+    return (p.parent_path() / (fp.prefix + "<frame>" + fp.suffix)).string();
 }
 
 // An attachment's sequence: the collider's eased one of the same files, else loaded (and eased
@@ -405,8 +411,6 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             ok = selectVertices(scene, spec.pins, what + " pins", mesh.positions, mesh.attributes,
                                 pins.vertices, errors) &&
                  ok;
-            if (ok && pins.vertices.empty())
-                warnings.push_back(what + ": the pins select no vertex");
             cloth->addPins(pins);
         }
         if (spec.hasAttach) {
@@ -423,8 +427,6 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             ok = selectVertices(scene, spec.attach, what + " attach", mesh.positions,
                                 mesh.attributes, att.vertices, errors) &&
                  ok;
-            if (ok && att.vertices.empty())
-                warnings.push_back(what + ": the attachment selects no vertex");
             if (ok) cloth->addPins(att);
         }
         if (ok) bodies.push_back(std::move(cloth));
@@ -502,7 +504,6 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             for (size_t s = 0; s < strands.strandCount(); ++s)
                 (isChosen[strands.offsets[s]] ? att.vertices : otherRoots)
                     .push_back(strands.offsets[s]);
-            if (att.vertices.empty()) warnings.push_back(what + ": the attachment selects no root");
             if (!mat.rootPinned) otherRoots.clear();
             mat.rootPinned = false;
         }

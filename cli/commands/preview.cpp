@@ -32,11 +32,20 @@ namespace gale::cli {
 
 namespace {
 
-// The --set overrides a run recorded in DIR/run.json (settings.sets), or none.
+// The --set overrides a run recorded in DIR/run.json (settings.sets), or none. A run.json that
+// is there but cannot be read (truncated, not JSON) is said: the picture then shows the scene
+// without the run's overrides.
 std::vector<std::string> recordedSets(const std::string& dir) {
-    std::ifstream in(std::filesystem::path(dir) / "run.json");
+    const std::filesystem::path path = std::filesystem::path(dir) / "run.json";
+    std::ifstream in(path);
     if (!in) return {};
     const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) {
+        std::cerr << "gale: warning: " << path.string()
+                  << " is not a run's JSON (truncated?): drawing the scene without the run's "
+                     "--set overrides\n";
+        return {};
+    }
     std::vector<std::string> sets;
     if (j.is_object() && j.contains("settings") && j["settings"].contains("sets") &&
         j["settings"]["sets"].is_array())

@@ -186,6 +186,7 @@ struct SubstepStatus {
     int contactConstraints = 0, contactAdded = 0, contactReleases = 0, contactSolves = 0;
     int clothConstraints = 0; // of contactConstraints: cloth held against cloth (setClothPlanes)
     int contactSlides = 0; // sticking contacts that turned to slide (friction at μ λ_n)
+    int contactsThrough = 0; // of contactAdded: vertices whose step went through the collider
     // The rotation projection (StepOptions::rotationProjection): edges beyond their target by
     // more than the tolerance before it, and the largest excess over the target (× rest).
     int rotationEdges = 0;
@@ -335,6 +336,8 @@ public:
     double edgeStretchOf(const VecX& x, size_t e) const;
     // Every vertex bound to a body's surface (hard and soft attachments) and its bound point at t.
     void attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const;
+    // The pin and attachment sets as added (addPins), in order.
+    const std::vector<PinSet>& pinSets() const { return mPinSets; }
     // The colliders will not be where the last substep left them at its end (a collider made
     // anew for the next substep): the distance bounds carried from it are dropped.
     void forgetColliderBounds() { mBoundTime = NAN; }
@@ -390,6 +393,10 @@ private:
     // The closest point of collider k's end pose to vertex i at x, unless the vertex is known to
     // be farther than `beyond` from it (mEndBound): then false, without a query.
     bool endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp);
+    // Whether vertex i's step x₀ → x₁ went through collider k, ending outside (the entry in at,
+    // cp).
+    bool passedThrough(size_t k, size_t i, const Vec3& xStart, const Vec3& x1, double h,
+                       double thick, Vec3& at, ContactPoint& cp);
     void assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
                   bool withMatrix = true);
     // The filtered backward-Euler residual g at Δv into mG (mX, mV, mF, and A when asked, left

@@ -59,6 +59,14 @@ bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dr
         out.positions[3 * i] = ps.columns[ix][i];
         out.positions[3 * i + 1] = ps.columns[iy][i];
         out.positions[3 * i + 2] = ps.columns[iz][i];
+        // (OBJ's reader checks its v lines; a PLY's binary floats can still hold NaN or ∞.)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(out.positions[3 * i + k])) {
+                error = path + ": error: vertex " + std::to_string(i + 1) +
+                        " (counting from 1) has a " + "non-finite " + "xyz"[k] + " (" +
+                        std::to_string(out.positions[3 * i + k]) + "): re-export the mesh";
+                return false;
+            }
     }
     for (size_t c = 0; c < ps.names.size(); ++c) {
         const std::string& name = ps.names[c];

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <queue>
 
 namespace gale::solver {
 
@@ -26,6 +27,58 @@ std::vector<uint8_t> heldBy(const Body& body) {
 
 const char* holder(uint8_t h) {
     return h == 2 ? "attachment" : "pin";
+}
+
+// How far the scene pulls its held vertices apart: the largest |x_a − x_b| / d_ab over pairs of
+// held vertices (pins, attachments), d_ab their distance along the cloth at rest — the shortest
+// path over edges, at least the rest geodesic, so the ratio is a lower bound of the stretch the
+// cloth between them must take, whatever the solver does. Dijkstra from up to kSources held
+// vertices, spread through them (a trouble frame's diagnosis, not every frame's).
+double pullApart(const Body& body, const std::vector<uint8_t>& held, int& va, int& vb) {
+    constexpr size_t kSources = 32;
+    std::vector<int> H;
+    for (size_t i = 0; i < held.size(); ++i)
+        if (held[i]) H.push_back(static_cast<int>(i));
+    if (H.size() < 2) return 0.0;
+    const size_t n = body.vertexCount();
+    const VecX& r = body.restPositions();
+    const VecX& x = body.positions();
+    std::vector<int> start(n + 1, 0), to(2 * body.edges().size());
+    std::vector<double> len(to.size());
+    for (const auto& e : body.edges()) ++start[e[0] + 1], ++start[e[1] + 1];
+    for (size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (const auto& e : body.edges()) {
+        const double l = (vec3At(r.data(), e[0]) - vec3At(r.data(), e[1])).norm();
+        to[fill[e[0]]] = e[1], len[fill[e[0]]++] = l;
+        to[fill[e[1]]] = e[0], len[fill[e[1]]++] = l;
+    }
+    double best = 0.0;
+    std::vector<double> d(n);
+    using Item = std::pair<double, int>;
+    const size_t step = std::max<size_t>(1, H.size() / kSources);
+    for (size_t k = 0; k < H.size(); k += step) {
+        const int s = H[k];
+        std::fill(d.begin(), d.end(), INFINITY);
+        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
+        d[s] = 0.0;
+        q.push({0.0, s});
+        while (!q.empty()) {
+            const auto [dist, u] = q.top();
+            q.pop();
+            if (dist > d[u]) continue;
+            if (held[u] && u != s && dist > 0.0) {
+                const double ratio = (vec3At(x.data(), u) - vec3At(x.data(), s)).norm() / dist;
+                if (ratio > best) best = ratio, va = s, vb = u;
+            }
+            for (int j = start[u]; j < start[u + 1]; ++j)
+                if (dist + len[j] < d[to[j]]) {
+                    d[to[j]] = dist + len[j];
+                    q.push({d[to[j]], to[j]});
+                }
+        }
+    }
+    return best;
 }
 
 } // namespace
@@ -110,7 +163,19 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
     if (s.count > 0) {
         s.position = 0.5 * (pos(s.vertex) + pos(s.other));
         const uint8_t a = held[s.vertex], b = held[s.other];
-        if (a && b) {
+        int pa = -1, pb = -1;
+        const double pulled = a && b ? 0.0 : pullApart(body, held, pa, pb);
+        if (pulled > overStretch) {
+            // Held vertices farther apart than the cloth between them can reach within the limit.
+            char buf[224];
+            std::snprintf(buf, sizeof buf,
+                          "the %s at vertex %d and the %s at vertex %d, %.3g m apart: %.3g× "
+                          "their distance along the cloth at rest",
+                          holder(held[pa]), pa, holder(held[pb]), pb, (pos(pa) - pos(pb)).norm(),
+                          pulled);
+            s.forcedBy = buf;
+            s.scene = true;
+        } else if (a && b) {
             s.forcedBy = a == b ? std::string(holder(a)) + "s" : "a pin and an attachment";
             s.scene = true;
         } else if (a || b) {

@@ -459,6 +459,7 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         stats.rotationSubsteps += st.rotationProjected ? 1 : 0;
         stats.stretchLimitSubsteps += st.stretchLimited ? 1 : 0;
         stats.contactAdded += st.contactAdded;
+        stats.contactsThrough += st.contactsThrough;
         stats.contactReleases += st.contactReleases;
         stats.contactSlides += st.contactSlides;
         stats.contactSolves += st.contactSolves;

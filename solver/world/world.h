@@ -97,8 +97,8 @@ struct BodyFrameStats {
     double rotationExcess = 0.0;
     int rotationSubsteps = 0; // substeps in which it ran
     int stretchLimitSubsteps = 0; // substeps the strain limit ([solver] stretch_limit) acted in
-    int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0,
-        projected = 0;
+    int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0, projected = 0,
+        contactsThrough = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
     // Intersecting triangle pairs with a triangle of this body at the end of the frame, counted
     // when it takes part in cloth–cloth collision (−1: not counted).

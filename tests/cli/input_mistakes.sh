@@ -1,0 +1,151 @@
+# Input mistakes a TD makes with bodies and meshes (issue 27, item 4; the brief: "bad input gets a
+# clear error naming file, line and column"), each said where it was made:
+# - an OBJ vertex that is not a number, not finite, missing a coordinate or beyond single
+#   precision: an error at its line and column (tinyobjloader alone reads them as 0 or inf);
+# - a body that only an attachment names, whose sequence is shorter than the run or in
+#   centimetres: the warnings a collider gets, at the attach key;
+# - a frame pattern that matches one file: the body would stand still, said at the key;
+# - a frame file that is a link to nothing (an unmounted cache): an error naming the link;
+# - another program's frame token (${F4}): the error lists the tokens gale reads;
+# - an attachment whose box selects nothing: a warning at the attach key;
+# - held vertices the scene pulls apart (a pinned edge and an attached edge 1 m apart): the
+#   frame's trouble says the scene forced it, naming both, not "the solver".
+source "$(dirname "$0")/lib.bash" "$@"
+command -v python3 > /dev/null || { echo "SKIP: python3 is not installed"; exit 0; }
+
+python3 - <<'PY'
+import os
+def grid(path, res, size, y0):
+    with open(path, 'w') as f:
+        for j in range(res + 1):
+            for i in range(res + 1):
+                f.write('v %.6f %.6f 0\n' % (-size / 2 + size * i / res, y0 + size * j / res))
+        for j in range(res):
+            for i in range(res):
+                a = j * (res + 1) + i + 1
+                f.write('f %d %d %d\nf %d %d %d\n' % (a, a + 1, a + res + 2, a, a + res + 2, a + res + 1))
+def box(path, dx, s=1.0):
+    with open(path, 'w') as f:
+        for x in (-0.2, 0.2):
+            for y in (0.9, 1.1):
+                for z in (-0.05, -0.01):
+                    f.write('v %.6f %.6f %.6f\n' % (s * (x + dx), s * y, s * z))
+        for q in ((1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)):
+            f.write('f %d %d %d %d\n' % q)
+grid('cape.obj', 6, 0.3, 0.75)
+os.makedirs('body', exist_ok=True)
+os.makedirs('cm', exist_ok=True)
+os.makedirs('one', exist_ok=True)
+for f in range(1, 6):
+    box('body/box.%04d.obj' % f, 0.02 * f)
+    box('cm/box.%04d.obj' % f, 0.02 * f, 100.0)
+box('one/box.0001.obj', 0.0)
+PY
+scene() { # ATTACH_MESH [EXTRA]
+    cat <<EOF
+[scene]
+fps = 24
+frames = [1, 8]
+substeps = 1
+
+[[cloth]]
+name = "c"
+mesh = "cape.obj"
+attach = { mesh = "$1", box = [-1, 1.04, -1, 1, 1.06, 1] }
+${2:-}
+EOF
+}
+
+# OBJ vertices: the line and column of the bad coordinate.
+for bad in "v abc 1 0|1:3|not a number|expected a number, found 'abc'" \
+    "v nan 1 0|1:3|nan|must be finite" "v 1 0|1:6|missing z|needs x, y and z" \
+    "v 1e999 1 0|1:3|1e999|out of range|beyond single precision" "v 1 4e38 0|1:5|4e38|beyond single precision"; do
+    IFS='|' read -r line at what want alt <<< "$bad"
+    { echo "$line"; sed 1d cape.obj; } > bad.obj
+    scene body/box.#.obj | sed 's|mesh = "cape.obj"|mesh = "bad.obj"|' > bad.toml
+    run "$GALE" check bad.toml
+    expect_rc 1 "an OBJ vertex with $what"
+    expect_match "$ERR" "bad.obj:$at: .*(${want}${alt:+|$alt})" "the error names bad.obj:$at ($what)"
+done
+
+# A body only the attachment names: a sequence shorter than the run, and one in centimetres.
+scene body/box.#.obj > short.toml
+run "$GALE" check short.toml
+expect_rc 0 "an attachment's short sequence (a warning)"
+expect_match "$ERR" "short.toml:9:[0-9]+: warning: .*attach: its mesh sequence .* has frames 1-5 but the run goes from frame 1 to 8" \
+    "the short sequence is warned of at the attach key"
+scene cm/box.#.obj > cm.toml
+run "$GALE" check cm.toml
+expect_match "$ERR" "cm.toml:9:[0-9]+: warning: .*attach: its body is .* centimetres" \
+    "a body in centimetres is warned of at the attach key"
+scene one/box.#.obj > one.toml
+run "$GALE" check one.toml
+expect_rc 0 "a one-file sequence (a warning)"
+expect_match "$ERR" "one.toml:9:[0-9]+: warning: .*matches one file \(frame 1\), so the body stands still" \
+    "a pattern that matches one file is warned of"
+
+# A frame linked to a cache that is not there.
+mkdir -p linked
+for f in 1 2 3 4 5; do ln -s "$PWD/body/box.000$f.obj" "linked/box.000$f.obj"; done
+rm linked/box.0003.obj
+ln -s /nonexistent/cache/box.0003.obj linked/box.0003.obj
+scene linked/box.#.obj > dangling.toml
+run "$GALE" check dangling.toml
+expect_rc 1 "a dangling frame link"
+expect_match "$ERR" "dangling.toml:9:[0-9]+: .*'box.0003.obj' .* is a link to /nonexistent/cache/box.0003.obj, which does not exist" \
+    "the error names the link and its target"
+
+# Houdini's ${F4} (not one of gale's spellings).
+scene 'body/box.${F4}.obj' > braces.toml
+run "$GALE" check braces.toml
+expect_rc 1 "an unknown frame token"
+expect_match "$ERR" "write the frame number as .*#.*%04d.*\\\$F4" "the error lists the tokens gale reads"
+
+# A box that selects nothing.
+scene body/box.#.obj | sed 's|box = \[-1, 1.04, -1, 1, 1.06, 1\]|box = [5, 5, 5, 6, 6, 6]|' > none.toml
+run "$GALE" check none.toml
+expect_match "$ERR" "none.toml:9:[0-9]+: warning: .*attach: it selects no vertex" \
+    "an empty selection is warned of at the attach key"
+
+# Held vertices pulled apart: the left column attached to a box walking away along -x, the right
+# column pinned; the cloth between them must stretch past 3x from frame 5 (4.7x by frame 8).
+python3 - <<'PY'
+import os
+os.makedirs('away', exist_ok=True)
+for f in range(1, 9):
+    dx = -0.16 * (f - 1)
+    with open('away/b.%04d.obj' % f, 'w') as o:
+        for x in (-0.2, -0.14):
+            for y in (0.7, 1.1):
+                for z in (-0.05, 0.05):
+                    o.write('v %.6f %.6f %.6f\n' % (x + dx, y, z))
+        for q in ((1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)):
+            o.write('f %d %d %d %d\n' % q)
+PY
+cat > apart.toml <<'EOF'
+[scene]
+fps = 24
+frames = [1, 8]
+substeps = 1
+
+[[cloth]]
+name = "c"
+mesh = "cape.obj"
+lift = 0.0
+drag = 0.0
+attach = { mesh = "away/b.#.obj", box = [-0.16, 0.7, -0.01, -0.14, 1.1, 0.01] }
+pins = { box = [0.14, 0.7, -0.01, 0.16, 1.1, 0.01] }
+EOF
+run "$GALE" sim apart.toml -o apart
+expect_rc 0 "the pulled-apart cloth"
+trouble=$(python3 -c "
+import json
+for f in json.load(open('apart/run.json'))['frames']:
+    for o in f['objects']:
+        for t in o['trouble']:
+            if t['kind'] == 'over_stretch': print(f['frame'], t['scene'], t['forced_by'])")
+echo "$trouble"
+expect_match "$trouble" "^[0-9]+ True the (pin|attachment) at vertex [0-9]+ and the (pin|attachment) at vertex [0-9]+, .* m apart" \
+    "the over-stretch is the scene's, naming the held vertices pulled apart"
+expect_no_match "$trouble" "the solver" "no frame blames the solver"
+finish
