@@ -637,7 +637,16 @@ void Body::rememberSliding(const VecX& v0, double h) {
             mSlidRate.assign(n, 0.0);
         }
         mSlidOn[i] = mContactCollider[i];
-        mSlidRate[i] = mFrictionDamping[i] / h;
+        // The next substep's slip, extrapolated from this one's change (an accelerating slide:
+        // c = μ λ_n / slip from this substep's end slip would hold it back in the next, whose
+        // rounds then spend themselves catching up — near the stick threshold a slide took 30
+        // frames to reach its acceleration): c for the same impulse at the predicted slip.
+        const Vec3 nrm = vec3At(mConstraints.normal.data(), i);
+        const Vec3 rel0 = vec3At(v0.data(), i) - vec3At(mContactVelocity.data(), i);
+        const double slip0 = (rel0 - nrm * rel0.dot(nrm)).norm(), slip1 = slipOf(i, v0);
+        const double predicted = slip1 + (slip1 - slip0);
+        const double ratio = std::clamp(slip1 / std::max(predicted, kSlipFloor), 0.5, 2.0);
+        mSlidRate[i] = mFrictionDamping[i] * ratio / h;
     }
 }
 
