@@ -26,7 +26,7 @@ std::vector<uint8_t> heldBy(const Body& body) {
 }
 
 const char* holder(uint8_t h) {
-    return h == 2 ? "attachment" : "pin";
+    return h == 2 ? "attachment" : h == 3 ? "moving collider touching it" : "pin";
 }
 
 // How far the scene pulls its held vertices apart: the largest |x_a − x_b| / d_ab over pairs of
@@ -164,15 +164,25 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
         s.position = 0.5 * (pos(s.vertex) + pos(s.other));
         const uint8_t a = held[s.vertex], b = held[s.other];
         int pa = -1, pb = -1;
-        const double pulled = a && b ? 0.0 : pullApart(body, held, pa, pb);
+        // Held for this: pins, attachments, and vertices a moving collider touches (pushed
+        // where the collider goes: a ball driven through a sheet pinned at its corners).
+        std::vector<uint8_t> pushed = held;
+        for (size_t i = 0; i < pushed.size() && !(a && b); ++i) {
+            if (pushed[i]) continue;
+            const int c = near(static_cast<int>(i));
+            if (c < 0) continue;
+            const ColliderPose& p = poses[static_cast<size_t>(c)];
+            if (p.moving || p.velA.squaredNorm() > 0.0 || p.velB.squaredNorm() > 0.0) pushed[i] = 3;
+        }
+        const double pulled = a && b ? 0.0 : pullApart(body, pushed, pa, pb);
         if (pulled > overStretch) {
             // Held vertices farther apart than the cloth between them can reach within the limit.
             char buf[224];
             std::snprintf(buf, sizeof buf,
                           "the %s at vertex %d and the %s at vertex %d, %.3g m apart: %.3g× "
                           "their distance along the cloth at rest",
-                          holder(held[pa]), pa, holder(held[pb]), pb, (pos(pa) - pos(pb)).norm(),
-                          pulled);
+                          holder(pushed[pa]), pa, holder(pushed[pb]), pb,
+                          (pos(pa) - pos(pb)).norm(), pulled);
             s.forcedBy = buf;
             s.scene = true;
         } else if (a && b) {
