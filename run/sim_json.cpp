@@ -153,6 +153,7 @@ std::string frameJson(const solver::FrameStats& f) {
           << ", \"line_search_cuts\": " << b.lineSearchCuts
           << ", \"newton_unconverged\": " << b.newtonStalled
           << ", \"max_speed\": " << num(b.maxSpeed) << ", \"max_stretch\": " << num(b.maxStretch)
+          << ", \"min_stretch\": " << num(b.minStretch)
           << ", \"energy\": {\"kinetic\": " << num(b.kinetic) << ", \"elastic\": " << num(b.elastic)
           << ", \"potential\": " << num(b.potential)
           << ", \"total\": " << num(b.kinetic + b.elastic + b.potential)
@@ -215,6 +216,7 @@ solver::FrameStats initialStats(const solver::World& w, int frame, double t) {
         solver::BodyFrameStats s;
         s.name = b->name();
         s.maxStretch = b->maxEdgeStretch();
+        s.minStretch = b->minEdgeStretch();
         s.kinetic = b->kineticEnergy();
         s.potential = b->potentialEnergy(w.settings().gravity);
         s.elastic = const_cast<Body&>(*b).elasticEnergy(f.time);

@@ -204,6 +204,13 @@ double Body::maxEdgeStretch() const {
     return maxEdgeStretchOf(mX);
 }
 
+double Body::minEdgeStretch() const {
+    double m = mEdges.empty() ? 1.0 : INFINITY;
+    for (size_t e = 0; e < mEdges.size(); ++e)
+        if (mEdgeRest[e] > 0.0) m = std::min(m, edgeStretchOf(mX, e));
+    return std::isfinite(m) ? m : 1.0;
+}
+
 double Body::edgeStretchOf(const VecX& x, size_t e) const {
     if (!(mEdgeRest[e] > 0.0)) return 0.0;
     return (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm() / mEdgeRest[e];

@@ -330,6 +330,7 @@ public:
     double potentialEnergy(const Vec3& gravity) const; // −Σ m g·x (J)
     double elasticEnergy(double t);                    // J, at the current positions
     double maxEdgeStretch() const;                     // max |e| / |e_rest|
+    double minEdgeStretch() const; // min |e| / |e_rest| (a squashed hair segment, a crushed fold)
     double maxEdgeStretchOf(const VecX& x) const;      // the same at positions x (NaN if any is)
     const std::vector<std::array<int, 2>>& edges() const { return mEdges; }
     // Edge e's length at positions x over its rest length (0 for an edge of zero rest length).

@@ -485,6 +485,7 @@ void World::finishBodyStats(Body& body, double t1, BodyFrameStats& stats) const 
     for (size_t i = 0; i < body.vertexCount(); ++i)
         stats.maxSpeed = std::max(stats.maxSpeed, vec3At(v.data(), i).norm());
     stats.maxStretch = body.maxEdgeStretch();
+    stats.minStretch = body.minEdgeStretch();
     stats.kinetic = body.kineticEnergy();
     stats.potential = body.potentialEnergy(mSettings.gravity);
     stats.elastic = body.elasticEnergy(t1);

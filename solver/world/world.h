@@ -81,6 +81,7 @@ struct BodyFrameStats {
     int newtonStalled = 0;          // substeps that ended above newton_tolerance
     double maxSpeed = 0.0;          // m/s at the end of the frame
     double maxStretch = 0.0;        // edge length / rest length at the end of the frame
+    double minStretch = 1.0;        // the shortest edge's, the same way
     double kinetic = 0.0, elastic = 0.0, potential = 0.0; // J, end of frame
     size_t windNonFinite = 0;
     int clampedJacobians = 0;
