@@ -339,6 +339,11 @@ bool Loader::attach(const toml::node& n, const std::string& what, const std::str
     }
     bool ok = true;
     const toml::node* m = t->get("mesh");
+    for (const toml::node* from : {m, &n}) { // the mesh's --set, else the table's
+        if (!from || !out.origin.empty()) continue;
+        const auto& path = from->source().path;
+        if (path && path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) out.origin = *path;
+    }
     std::string file;
     if (!m) {
         error(n, what + " needs mesh = \"file\" (the body to attach to: OBJ/PLY, or a '#' sequence)");

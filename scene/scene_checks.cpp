@@ -122,17 +122,20 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         const ClothSpec& spec = scene.cloths[i];
         const std::string what = "[[cloth]] '" + spec.name + "'";
         if (spec.hasPins && heldBy(*bodies[i], false) == 0)
-            warnAt(spec.pins.line, spec.pins.col,
-                   what + " pins: they select no vertex: check the box, vertices or map");
+            out.push_back(specError(
+                scene.wind.path, spec.pins,
+                what + " pins: they select no vertex: check the box, vertices or map", true));
         if (spec.hasAttach && heldBy(*bodies[i], true) == 0)
-            warnAt(spec.attach.line, spec.attach.col,
-                   what + " attach: it selects no vertex: check the box, vertices or map");
+            out.push_back(specError(
+                scene.wind.path, spec.attach,
+                what + " attach: it selects no vertex: check the box, vertices or map", true));
     }
     for (size_t j = 0; j < scene.hairs.size() && scene.cloths.size() + j < bodies.size(); ++j) {
         const HairSpec& spec = scene.hairs[j];
         if (spec.hasAttach && heldBy(*bodies[scene.cloths.size() + j], true) == 0)
-            warnAt(spec.attach.line, spec.attach.col,
-                   "[[hair]] '" + spec.name + "' attach: it selects no root: check the box");
+            out.push_back(specError(
+                scene.wind.path, spec.attach,
+                "[[hair]] '" + spec.name + "' attach: it selects no root: check the box", true));
     }
     // Attached edges (both ends bound to a body's surface) that the body's motion stretches or
     // compresses past kBindingLimit over the run's frames: the cloth there cannot do better than

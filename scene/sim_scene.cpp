@@ -24,6 +24,19 @@
 
 namespace gale::scene {
 
+SceneError specError(const std::string& file, const PinSpec& spec, std::string message,
+                     bool warning) {
+    SceneError e;
+    if (!spec.origin.empty()) {
+        e.file = spec.origin;
+        e.message = std::move(message);
+    } else {
+        e = sceneErrorAt(file, spec.line, spec.col, std::move(message));
+    }
+    e.warning = warning;
+    return e;
+}
+
 using namespace gale::solver;
 
 namespace {
@@ -420,8 +433,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             att.bindTime = bindTime;
             att.stiffness = spec.attach.stiffness;
             if (!att.attach) {
-                errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
-                                            what + " attach: " + problem));
+                errors.push_back(
+                    specError(scene.wind.path, spec.attach, what + " attach: " + problem));
                 ok = false;
             }
             ok = selectVertices(scene, spec.attach, what + " attach", mesh.positions,
@@ -489,8 +502,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             att.bindTime = bindTime;
             att.stiffness = spec.attach.stiffness;
             if (!att.attach) {
-                errors.push_back(sceneError(scene, spec.attach.line, spec.attach.col,
-                                            what + " attach: " + problem));
+                errors.push_back(
+                    specError(scene.wind.path, spec.attach, what + " attach: " + problem));
                 continue;
             }
             std::vector<int> chosen;

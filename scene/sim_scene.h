@@ -40,7 +40,15 @@ struct PinSpec {
     solver::PinRotation rotate;
     double stiffness = 0.0; // attach: N/m per vertex, a soft attachment (0: hard)
     int line = 0, col = 0;
+    // The `--set KEY=VALUE` that gave the table or its mesh, when one did: problems found later
+    // (the mesh cannot be read, the selection is empty) are said there, not at the scene's line.
+    std::string origin;
 };
+
+// An error (or, with `warning`, a warning) at a pins or attach key: its `--set` when one gave
+// it, else its line and column in `file`.
+SceneError specError(const std::string& file, const PinSpec& spec, std::string message,
+                     bool warning = false);
 
 struct ClothSpec {
     std::string name;

@@ -7,7 +7,8 @@
 # - a frame pattern that matches one file: the body would stand still, said at the key;
 # - a frame file that is a link to nothing (an unmounted cache): an error naming the link;
 # - another program's frame token (${F4}): the error lists the tokens gale reads;
-# - an attachment whose box selects nothing: a warning at the attach key;
+# - an attachment whose box selects nothing: a warning at the attach key; a --set attach mesh
+#   that cannot be read: an error at that --set;
 # - held vertices the scene pulls apart (a pinned edge and an attached edge 1 m apart): the
 #   frame's trouble says the scene forced it, naming both, not "the solver".
 source "$(dirname "$0")/lib.bash" "$@"
@@ -100,6 +101,12 @@ scene 'body/box.${F4}.obj' > braces.toml
 run "$GALE" check braces.toml
 expect_rc 1 "an unknown frame token"
 expect_match "$ERR" "write the frame number as .*#.*%04d.*\\\$F4" "the error lists the tokens gale reads"
+
+# A --set that names a mesh that is not there: said at the --set, not at the scene's attach line.
+run "$GALE" check short.toml --set cloth.c.attach.mesh=nowhere.obj
+expect_rc 1 "an attach mesh from --set that does not exist"
+expect_match "$ERR" "^--set cloth.c.attach.mesh=nowhere.obj: error: .*cannot read 'nowhere.obj'" \
+    "the error is at the --set"
 
 # A box that selects nothing.
 scene body/box.#.obj | sed 's|box = \[-1, 1.04, -1, 1, 1.06, 1\]|box = [5, 5, 5, 6, 6, 6]|' > none.toml
