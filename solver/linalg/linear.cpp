@@ -204,6 +204,11 @@ SolveStatus FilteredSolver::solve(const BlockMatrix& A, const Constraints& c, co
     return st;
 }
 
+void FilteredSolver::squaredWeights(size_t n3) {
+    mW2.resize(mWeights.empty() ? 0 : static_cast<long>(n3));
+    for (long k = 0; k < mW2.size(); ++k) mW2[k] = mWeights[k / 3] * mWeights[k / 3];
+}
+
 double FilteredSolver::residualNorm(const VecX& r) {
     const size_t n3 = static_cast<size_t>(r.size());
     if (mW2.size() == 0) return std::sqrt(deterministicDot(r.data(), r.data(), n3));
@@ -232,12 +237,7 @@ SolveStatus FilteredSolver::solvePcg(const BlockMatrix& A, const Constraints& c,
                 out.segment<3>(3 * i).noalias() = mPrecond[i] * r.segment<3>(3 * i);
         });
     };
-    mW2.resize(0);
-    if (!mWeights.empty()) {
-        mW2.resize(static_cast<long>(n3));
-        for (size_t k = 0; k < n3; ++k)
-            mW2[static_cast<long>(k)] = mWeights[k / 3] * mWeights[k / 3];
-    }
+    squaredWeights(n3);
     const double rhsNorm = residualNorm(rhs);
     if (trivialRhs(rhsNorm, y, st)) return st;
     mR.resize(n3);
@@ -388,12 +388,7 @@ SolveStatus FilteredSolver::solvePcgMultigrid(const BlockMatrix& A, const Constr
                                               double tolerance, int maxIterations) {
     SolveStatus st;
     const size_t n3 = 3 * static_cast<size_t>(A.size());
-    mW2.resize(0);
-    if (!mWeights.empty()) {
-        mW2.resize(static_cast<long>(n3));
-        for (size_t k = 0; k < n3; ++k)
-            mW2[static_cast<long>(k)] = mWeights[k / 3] * mWeights[k / 3];
-    }
+    squaredWeights(n3);
     const double rhsNorm = residualNorm(rhsNatural);
     if (trivialRhs(rhsNorm, yNatural, st)) return st;
     if (!mMultigrid.refresh(A, c, mConstrained, mKeepCoarse)) {

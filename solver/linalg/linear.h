@@ -158,6 +158,7 @@ private:
     VecX mW2, mWr;                // w² per row component, in the order the solve runs in; w² r
     // ‖r‖ or, with weights, ‖W r‖ (mW2 set up for the solve's order).
     double residualNorm(const VecX& r);
+    void squaredWeights(size_t n3); // mW2 from mWeights, natural order
     BlockMultigrid mMultigrid;
     VecX mTmp2, mR, mZ, mP, mQ;
     VecX mRhsLevel, mYLevel; // multigrid PCG's rhs and y in the multigrid's level-0 order
