@@ -52,6 +52,18 @@ bool layoutSlice(int width, int height, double boundsW, double boundsH, bool tim
     return true;
 }
 
+std::string smallestSliceSize(int width, int height, double boundsW, double boundsH,
+                              bool timeline) {
+    const double ratio = width > 0 && height > 0 ? static_cast<double>(height) / width : 1.0;
+    SliceLayout l;
+    for (int w = 64; w <= 16384; w += 32) {
+        const int h = std::max(160, static_cast<int>(std::ceil(w * ratio / 32.0)) * 32);
+        if (w >= 200 && layoutSlice(w, h, boundsW, boundsH, timeline, l))
+            return std::to_string(w) + "x" + std::to_string(h);
+    }
+    return "larger";
+}
+
 SliceLayout layoutThumbnail(int width, int height, double boundsW, double boundsH) {
     SliceLayout l;
     l.width = width;

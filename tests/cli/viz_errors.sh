@@ -15,6 +15,14 @@ run "$GALE" viz -e "$F" --bounds 0,0,1,1 --size 12x -o a.png
 expect_rc 2 "bad size"
 run "$GALE" viz -e "$F" --bounds 0,0,1,1 --size 100x100 -o a.png
 expect_rc 2 "too small"
+run "$GALE" viz -e "$F" --bounds 0,0,1,1 --size 220x160 -o a.png
+expect_rc 2 "too small for the axes and legend"
+# The refusal names a size that fits (and that size draws).
+expect_match "$ERR" "too small for a picture of these bounds with its axes and legend: give --size [0-9]+x[0-9]+ or larger" \
+    "too small names the smallest size"
+fits=$(printf '%s\n' "$ERR" | grep -oE -- "--size [0-9]+x[0-9]+" | tail -1 | cut -d' ' -f2)
+run "$GALE" viz -e "$F" --bounds 0,0,1,1 --size "$fits" -o fits.png
+expect_rc 0 "the size the refusal named ($fits)"
 run "$GALE" viz -e "$F" --bounds 0,0,1,1 -o a.jpg
 expect_rc 2 "unknown picture format"
 run "$GALE" viz -e "$F" --bounds 0,0,1,1
