@@ -16,8 +16,10 @@ bool isDigit(char c) {
     return c >= '0' && c <= '9';
 }
 
-// The token starting at `i` of `s`, if any: its length and width.
-bool tokenAt(const std::string& s, size_t i, size_t& length, int& width) {
+// The token starting at `i` of `s`, if any: its length and width (and whether it is printf's,
+// whose width counts a minus sign).
+bool tokenAt(const std::string& s, size_t i, size_t& length, int& width, bool* printf = nullptr) {
+    if (printf) *printf = s[i] == '%';
     if (s[i] == '#') {
         size_t end = s.find_first_not_of('#', i);
         if (end == std::string::npos) end = s.size();
@@ -62,7 +64,8 @@ bool parseFramePattern(const std::string& name, FramePattern& out, std::string* 
     for (size_t i = 0; i < name.size();) {
         size_t length = 0;
         int width = 0;
-        if (!tokenAt(name, i, length, width)) {
+        bool printf = false;
+        if (!tokenAt(name, i, length, width, &printf)) {
             ++i;
             continue;
         }
@@ -76,6 +79,7 @@ bool parseFramePattern(const std::string& name, FramePattern& out, std::string* 
         out.prefix = name.substr(0, i);
         out.suffix = name.substr(i + length);
         out.width = width;
+        out.signInWidth = printf;
         i += length;
     }
     return found;
@@ -83,8 +87,8 @@ bool parseFramePattern(const std::string& name, FramePattern& out, std::string* 
 
 std::string formatFrame(const FramePattern& p, long frame) {
     std::string digits = std::to_string(frame < 0 ? -frame : frame);
-    if (digits.size() < static_cast<size_t>(p.width))
-        digits.insert(0, p.width - digits.size(), '0');
+    const int width = p.signInWidth && frame < 0 ? p.width - 1 : p.width; // printf: -001
+    if (digits.size() < static_cast<size_t>(width)) digits.insert(0, width - digits.size(), '0');
     if (frame < 0) digits.insert(0, 1, '-');
     return p.prefix + digits + p.suffix;
 }

@@ -13,6 +13,7 @@ extern const char* const kFrameTokens;
 struct FramePattern {
     std::string prefix, suffix; // the name around the token
     int width = 4;              // digits, zero-padded (1: unpadded); the sign comes first
+    bool signInWidth = false;   // %04d: printf's width counts the sign (frame -1 is -001)
 };
 
 // True when `name` holds a frame token anywhere (a sequence rather than a single file).
@@ -21,7 +22,7 @@ bool hasFrameToken(const std::string& name);
 // The one frame token of `name`. False when it has none, or (with `error` set) more than one.
 bool parseFramePattern(const std::string& name, FramePattern& out, std::string* error = nullptr);
 
-// The name of `frame` (frame -3 at width 4 -> `-0003`).
+// The name of `frame` (frame -3 at width 4 -> `-0003`; `%04d` as printf writes it, `-003`).
 std::string formatFrame(const FramePattern& p, long frame);
 
 // The frame number of `name` when it is exactly what formatFrame writes for some frame

@@ -37,6 +37,18 @@ TEST_CASE("frame tokens: '#' runs, %0Nd and $FN format as their DCCs do", "[io][
     std::string out;
     REQUIRE(framePath("v.$F4.npy", -3, out));
     CHECK(out == "v.-0003.npy");
+    // printf's width counts the sign: a pre-roll cache written with %04d from frame -5.
+    for (long frame : {-1L, -5L, -42L, -1234L}) {
+        char expected[64];
+        std::snprintf(expected, sizeof expected, "body.%04d.obj", static_cast<int>(frame));
+        REQUIRE(framePath("body.%04d.obj", frame, out));
+        CHECK(out == expected);
+        FramePattern p;
+        REQUIRE(parseFramePattern("body.%04d.obj", p));
+        long back = 0;
+        CHECK(matchFrame(p, expected, back));
+        CHECK(back == frame);
+    }
 }
 
 TEST_CASE("frame tokens: names that are not frames of the pattern", "[io][frames]") {
