@@ -52,16 +52,20 @@ bool layoutSlice(int width, int height, double boundsW, double boundsH, bool tim
     return true;
 }
 
-std::string smallestSliceSize(int width, int height, double boundsW, double boundsH,
-                              bool timeline) {
+std::string sliceTooSmall(int width, int height, double boundsW, double boundsH, bool timeline) {
     const double ratio = width > 0 && height > 0 ? static_cast<double>(height) / width : 1.0;
+    std::string fits = "larger";
     SliceLayout l;
-    for (int w = 64; w <= 16384; w += 32) {
+    for (int w = 224; w <= 16384; w += 32) {
         const int h = std::max(160, static_cast<int>(std::ceil(w * ratio / 32.0)) * 32);
-        if (w >= 200 && layoutSlice(w, h, boundsW, boundsH, timeline, l))
-            return std::to_string(w) + "x" + std::to_string(h);
+        if (layoutSlice(w, h, boundsW, boundsH, timeline, l)) {
+            fits = std::to_string(w) + "x" + std::to_string(h);
+            break;
+        }
     }
-    return "larger";
+    return std::string("is too small for a picture of these bounds with its axes") +
+           (timeline ? ", legend and gust timeline" : " and legend") + ": give --size " + fits +
+           " or larger";
 }
 
 SliceLayout layoutThumbnail(int width, int height, double boundsW, double boundsH) {

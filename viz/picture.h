@@ -32,9 +32,9 @@ struct SliceLayout {
 // False when the picture is too small to hold a plot (under about 200 x 150 pixels).
 bool layoutSlice(int width, int height, double boundsW, double boundsH, bool timeline,
                  SliceLayout& out);
-// The smallest "WxH" (multiples of 32, keeping width:height) at which layoutSlice fits, for the
-// message that refuses a smaller --size.
-std::string smallestSliceSize(int width, int height, double boundsW, double boundsH, bool timeline);
+// Why layoutSlice refused width x height, for `--size WxH` + this: what the picture holds and the
+// smallest size (multiples of 32, keeping width:height, at least 224x160) at which it fits.
+std::string sliceTooSmall(int width, int height, double boundsW, double boundsH, bool timeline);
 
 // The sampled slice: the world velocity at the centre of every plot pixel.
 struct Slice {

@@ -350,13 +350,9 @@ int runVizFrames(const VizOptions& o) {
         viz::SliceLayout layout;
         if (!viz::layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present,
                               layout)) {
-            printError("--size " + o.size +
-                       " is too small for a picture of these bounds with its axes" +
-                       (overlays.timeline.present ? ", legend and gust timeline" : " and legend") +
-                       ": give --size " +
-                       viz::smallestSliceSize(width, height, b[2] - b[0], b[3] - b[1],
-                                              overlays.timeline.present) +
-                       " or larger");
+            printError("--size " + o.size + " " +
+                       viz::sliceTooSmall(width, height, b[2] - b[0], b[3] - b[1],
+                                          overlays.timeline.present));
             return kExitUsage;
         }
         viz::Slice slice;
