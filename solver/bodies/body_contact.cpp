@@ -295,12 +295,9 @@ bool Body::passedThrough(size_t k, size_t i, const Vec3& xStart, const Vec3& x1,
                                ? 0.0 // a static mesh does not move
                                : h * std::max(pose.velA.norm(), pose.velB.norm());
     const double length = (x1 - xStart).norm() + surface;
-    const size_t slot = k * vertexCount() + i;
-    if (slot < mEndBound.size() && mEndBound[slot] >= 0.0 &&
-        mEndBound[slot] - (x1 - vec3At(mEndAt.data(), slot)).norm() - thick > length)
+    ContactPoint end;
+    if (!endPoseQuery(k, i, x1, thick + length, end) || !(end.distance - thick <= length))
         return false;
-    const ContactPoint end = queryCollider(pose, x1);
-    if (!(end.distance - thick <= length)) return false;
     // Through means into the collider's skin past a quarter of the thickness: a vertex resting
     // at the thickness whose path grazes it (a static mesh's interpolated distance is not
     // exactly 1-Lipschitz) is the end-pose test's, not this one's. The contact is then made
