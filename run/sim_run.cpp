@@ -115,8 +115,7 @@ RunError SimRun::load(const SimSetup& s, std::string& report) {
     // simulation starts: the run-up's first frame (the bodies' rest pose under a pre-roll).
     const int shotStart = std::min(mFirst, mScene.wind.settings.frameStart);
     mRunUpFrom = shotStart - mScene.wind.settings.preroll;
-    if (!scene::prerollSequences(mScene, shotStart, errors)) return sceneErrors(errors);
-    if (!scene::buildBodies(mScene, bodies, errors, warnings, s.allowPaths, mRunUpFrom))
+    if (!scene::buildShotBodies(mScene, shotStart, bodies, errors, warnings, s.allowPaths))
         return sceneErrors(errors);
     mWarnings.clear();
     for (const std::string& w : warnings) {

@@ -87,10 +87,14 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                                     int first, int last) {
     std::vector<SceneError> out;
     const fields::SceneSettings& s = scene.wind.settings;
-    auto warn = [&](const solver::Collider& c, std::string message) {
-        SceneError e = sceneErrorAt(scene.wind.path, c.line, c.col, std::move(message));
+    // A warning at a key's line and column; warn(c, ...) at a collider's.
+    const auto warnAt = [&](int line, int col, std::string message) {
+        SceneError e = sceneErrorAt(scene.wind.path, line, col, std::move(message));
         e.warning = true;
         out.push_back(std::move(e));
+    };
+    const auto warn = [&](const solver::Collider& c, std::string message) {
+        warnAt(c.line, c.col, std::move(message));
     };
     Box cloth;
     double clothExtent = 0.0;
@@ -107,11 +111,6 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         cloth.add(bodyBoxes.back());
     }
     // A selection that holds nothing (a box beside the cloth, a map that is zero everywhere).
-    const auto warnAt = [&](int line, int col, std::string message) {
-        SceneError e = sceneErrorAt(scene.wind.path, line, col, std::move(message));
-        e.warning = true;
-        out.push_back(std::move(e));
-    };
     const auto heldBy = [](const solver::Body& body, bool attachments) {
         size_t n = 0;
         for (const solver::PinSet& set : body.pinSets())
@@ -177,17 +176,14 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         }
         if (!past) continue;
         const auto& ed = body.edges()[worstEdge];
-        SceneError e = sceneErrorAt(
-            scene.wind.path, spec.attach.line, spec.attach.col,
-            "[[cloth]] '" + spec.name + "' attach: the body's motion " +
+        warnAt(spec.attach.line, spec.attach.col,
+               "[[cloth]] '" + spec.name + "' attach: the body's motion " +
                 (worst > 1.0 ? "stretches" : "compresses") + " the attached edges to " +
                 metres(worst) + "x their length (edge " + std::to_string(ed[0]) + "-" +
                 std::to_string(ed[1]) + " at frame " + std::to_string(worstFrame) + "; " +
                 std::to_string(past) + " edge-frames past +/-" + metres(100.0 * kBindingLimit) +
                 " %): the cloth there follows the skin (hard) or fights it (stiffness); bind "
                 "closer to the surface, where the body deforms less, or soften it with stiffness");
-        e.warning = true;
-        out.push_back(std::move(e));
     }
     // Step keys on motion: pins' translation and a sphere's or capsule's position jump within
     // one substep, at a speed no cloth can follow (it stretches, then snaps back; the hard
@@ -209,10 +205,8 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         double at = 0.0;
         const double jump = pins.translate.stepJump(t0, t1, &at);
         if (!(jump > solver::kTeleportTolerance)) return;
-        SceneError e = sceneErrorAt(scene.wind.path, pins.line, pins.col,
-                                    teleport(what, "translate", jump, at));
-        e.warning = true;
-        out.push_back(std::move(e));
+        warnAt(pins.line, pins.col,
+               teleport(what, "translate", jump, at));
     };
     for (const ClothSpec& spec : scene.cloths)
         if (spec.hasPins) pinsTeleport("[[cloth]] '" + spec.name + "' pins", spec.pins);
@@ -247,17 +241,14 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                 frames += inside;
             }
             if (worstVertex < 0) continue;
-            SceneError e = sceneErrorAt(
-                scene.wind.path, spec.pins.line, spec.pins.col,
-                "[[cloth]] '" + spec.name + "' pins: they hold vertices inside [[collider]] '" +
+            warnAt(spec.pins.line, spec.pins.col,
+                   "[[cloth]] '" + spec.name + "' pins: they hold vertices inside [[collider]] '" +
                     c.name + "' in " + std::to_string(frames) + " frame(s) of the run (vertex " +
                     std::to_string(worstVertex) + " " + metres(worst) +
                     " m below its surface at frame " + std::to_string(worstFrame) +
                     "): the cloth there can neither leave the collider nor stay on the pins, and "
                     "stretches between them; move the pins (or their translate keys) or the "
                     "collider");
-            e.warning = true;
-            out.push_back(std::move(e));
         }
     }
     // Hair that starts through a colliding cloth (its segments crossing the cloth's triangles):
@@ -274,15 +265,12 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
             char where[96];
             std::snprintf(where, sizeof where, "(%.4g, %.4g, %.4g)", through.at.x(), through.at.y(),
                           through.at.z());
-            SceneError e = sceneErrorAt(
-                scene.wind.path, scene.hairs[j].line, scene.hairs[j].col,
-                "[[hair]] '" + scene.hairs[j].name + "' starts through [[cloth]] '" +
+            warnAt(scene.hairs[j].line, scene.hairs[j].col,
+                   "[[hair]] '" + scene.hairs[j].name + "' starts through [[cloth]] '" +
                     scene.cloths[i].name + "': " + std::to_string(through.segments) +
                     " segment(s) cross it (the first at " + where +
                     "); the run lets them through the cloth until they are clear of it, so the "
                     "strands end up on either side: start the hair clear of the cloth");
-            e.warning = true;
-            out.push_back(std::move(e));
         }
     }
     for (const solver::Collider& c : scene.colliders) {

@@ -277,6 +277,14 @@ bool prerollSequences(SimScene& scene, int toFrame, std::vector<SceneError>& err
     return ok;
 }
 
+bool buildShotBodies(SimScene& scene, int shotStart, std::vector<std::unique_ptr<Body>>& bodies,
+                     std::vector<SceneError>& errors, std::vector<std::string>& warnings,
+                     const std::vector<std::string>& allowPaths) {
+    return prerollSequences(scene, shotStart, errors) &&
+           buildBodies(scene, bodies, errors, warnings, allowPaths,
+                       shotStart - scene.wind.settings.preroll);
+}
+
 WorldSettings worldSettings(const SimScene& scene, int threads) {
     WorldSettings ws;
     const fields::SceneSettings& s = scene.wind.settings;

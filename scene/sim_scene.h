@@ -156,6 +156,14 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<solver::Body
                  std::vector<SceneError>& errors, std::vector<std::string>& warnings,
                  const std::vector<std::string>& allowPaths = {}, int firstFrame = INT_MIN);
 
+// The bodies of a run whose written frames start at `shotStart`, as `gale sim` makes them and
+// `gale check` looks at them: prerollSequences to shotStart, then buildBodies bound at the
+// run-up's first frame, shotStart − preroll (the bodies' rest pose under a pre-roll).
+bool buildShotBodies(SimScene& scene, int shotStart,
+                     std::vector<std::unique_ptr<solver::Body>>& bodies,
+                     std::vector<SceneError>& errors, std::vector<std::string>& warnings,
+                     const std::vector<std::string>& allowPaths = {});
+
 // World settings of a scene (threads: 0 for all hardware threads).
 solver::WorldSettings worldSettings(const SimScene& scene, int threads);
 

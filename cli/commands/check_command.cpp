@@ -35,14 +35,9 @@ int checkScene(const std::string& path, const std::vector<std::string>& sets,
     if (!report.empty()) std::cerr << report << std::flush;
     std::vector<std::unique_ptr<solver::Body>> bodies;
     std::vector<std::string> warnings;
-    // The bodies as `gale sim` builds them (run/sim_run.cpp): under a pre-roll the sequences
-    // eased from their rest poses and the attachments bound at the run-up's first frame, so
-    // that the two print the same warnings.
-    const int runUpFrom = sim.wind.settings.frameStart - sim.wind.settings.preroll;
-    if (!gale::scene::prerollSequences(sim, sim.wind.settings.frameStart, errors))
-        return printSceneErrors(errors);
-    const bool built =
-        gale::scene::buildBodies(sim, bodies, errors, warnings, allowPaths, runUpFrom);
+    // The bodies as `gale sim` makes them, so that the two print the same warnings.
+    const bool built = gale::scene::buildShotBodies(sim, sim.wind.settings.frameStart, bodies,
+                                                    errors, warnings, allowPaths);
     for (const std::string& w : warnings) std::cerr << "gale: warning: " << w << '\n';
     if (!built) return printSceneErrors(errors);
     for (const scene::SceneError& w : gale::scene::runWarnings(
