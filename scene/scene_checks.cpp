@@ -176,8 +176,9 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         }
         if (!past) continue;
         const auto& ed = body.edges()[worstEdge];
-        warnAt(spec.attach.line, spec.attach.col,
-               "[[cloth]] '" + spec.name + "' attach: the body's motion " +
+        warnAt(
+            spec.attach.line, spec.attach.col,
+            "[[cloth]] '" + spec.name + "' attach: the body's motion " +
                 (worst > 1.0 ? "stretches" : "compresses") + " the attached edges to " +
                 metres(worst) + "x their length (edge " + std::to_string(ed[0]) + "-" +
                 std::to_string(ed[1]) + " at frame " + std::to_string(worstFrame) + "; " +
@@ -205,8 +206,7 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         double at = 0.0;
         const double jump = pins.translate.stepJump(t0, t1, &at);
         if (!(jump > solver::kTeleportTolerance)) return;
-        warnAt(pins.line, pins.col,
-               teleport(what, "translate", jump, at));
+        warnAt(pins.line, pins.col, teleport(what, "translate", jump, at));
     };
     for (const ClothSpec& spec : scene.cloths)
         if (spec.hasPins) pinsTeleport("[[cloth]] '" + spec.name + "' pins", spec.pins);
@@ -241,8 +241,9 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                 frames += inside;
             }
             if (worstVertex < 0) continue;
-            warnAt(spec.pins.line, spec.pins.col,
-                   "[[cloth]] '" + spec.name + "' pins: they hold vertices inside [[collider]] '" +
+            warnAt(
+                spec.pins.line, spec.pins.col,
+                "[[cloth]] '" + spec.name + "' pins: they hold vertices inside [[collider]] '" +
                     c.name + "' in " + std::to_string(frames) + " frame(s) of the run (vertex " +
                     std::to_string(worstVertex) + " " + metres(worst) +
                     " m below its surface at frame " + std::to_string(worstFrame) +
@@ -267,10 +268,10 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                           through.at.z());
             warnAt(scene.hairs[j].line, scene.hairs[j].col,
                    "[[hair]] '" + scene.hairs[j].name + "' starts through [[cloth]] '" +
-                    scene.cloths[i].name + "': " + std::to_string(through.segments) +
-                    " segment(s) cross it (the first at " + where +
-                    "); the run lets them through the cloth until they are clear of it, so the "
-                    "strands end up on either side: start the hair clear of the cloth");
+                       scene.cloths[i].name + "': " + std::to_string(through.segments) +
+                       " segment(s) cross it (the first at " + where +
+                       "); the run lets them through the cloth until they are clear of it, so the "
+                       "strands end up on either side: start the hair clear of the cloth");
         }
     }
     for (const solver::Collider& c : scene.colliders) {

@@ -154,9 +154,9 @@ int runViz(const VizOptions& o) {
     viz::SliceLayout layout;
     if (!viz::layoutSlice(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present,
                           layout)) {
-        printError("--size " + o.size + " " +
-                   viz::sliceTooSmall(width, height, b[2] - b[0], b[3] - b[1],
-                                      overlays.timeline.present));
+        printError(
+            "--size " + o.size + " " +
+            viz::sliceTooSmall(width, height, b[2] - b[0], b[3] - b[1], overlays.timeline.present));
         return kExitUsage;
     }
     viz::Slice slice;
