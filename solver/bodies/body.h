@@ -470,6 +470,11 @@ private:
     std::vector<double> mStartBound;
     VecX mStartAt;
     double mBoundTime = NAN;
+    // Per collider and vertex, within a substep: the step's path to mSweptAt ended behind no face
+    // of the moving mesh it met (1), or no deeper than updateContacts' re-planing depth (2); 0
+    // unknown. updateContacts does not ask the continuous test again for the same end.
+    std::vector<uint8_t> mSweptClear;
+    VecX mSweptAt;
     // Per collider and vertex: the moving mesh's triangle its last query found closest (−1
     // none), the hint of its next query (the answer does not depend on it).
     std::vector<int> mNearTriangle;

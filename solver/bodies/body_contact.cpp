@@ -25,6 +25,9 @@ constexpr double kSlipFloor = 1e-3;
 // passedThrough: a path counts as having gone through a collider once it came within this
 // fraction of the thickness of it.
 constexpr double kThroughDepth = 0.25;
+// A sliding contact on a moving mesh whose vertex ends this fraction of the thickness behind the
+// face its path met takes that face's plane (updateContacts).
+constexpr double kReplaneDepth = 0.25;
 // A projection after the solve smaller than this (m, or m per substep of speed) is rounding.
 constexpr double kProjectionSlop = 1e-6;
 
@@ -121,6 +124,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     if (mNearTriangle.size() != slots) mNearTriangle.assign(slots, -1);
     mEndBound.assign(slots, -1.0);
     mEndAt.resize(3 * static_cast<Eigen::Index>(slots));
+    mSweptClear.assign(slots, 0);
+    mSweptAt.resize(3 * static_cast<Eigen::Index>(slots));
     mBoundTime = t + h; // the end pose's time, for the next substep
     // A is assembled anew for the substep: no friction in it.
     mFrictionDamping.assign(n, 0.0);
@@ -440,6 +445,38 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         }
     }
     const double t1 = t + h;
+    // A contact sliding on a moving mesh holds its vertex on the plane it was made with, which
+    // moves with the surface point but does not turn or bend with it: on a head turning fast
+    // under hair (8 mm a substep at the scalp) the vertex slid along the plane and ended behind
+    // the face its path met, 8.6 mm deep, and the continuous pass after the solve put it back at
+    // that point, squashing its segments to 0.81×. Such a contact takes that face's plane
+    // instead (a new linearisation of the surface where the vertex went), keeping its friction,
+    // and the rounds solve again.
+    for (size_t i = 0; i < n; ++i) {
+        const int ci = mContactCollider[i];
+        if (ci < 0 || static_cast<size_t>(ci) >= mKin.colliders.size() || mConstraints.kind[i] != 2)
+            continue;
+        const Collider& c = (*env.colliders)[static_cast<size_t>(ci)];
+        if (!c.moving) continue;
+        const double thick = mKin.colliders[static_cast<size_t>(ci)].thickness;
+        const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
+        const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
+        const size_t slot = static_cast<size_t>(ci) * n + i;
+        if (mSweptClear[slot] && vec3At(mSweptAt.data(), slot) == x1) continue;
+        ContactPoint cp;
+        const bool behind = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
+                            cp.distance < -kReplaneDepth * thick;
+        mSweptClear[slot] = behind ? 0 : 2;
+        vec3At(mSweptAt.data(), slot) = x1;
+        if (!behind) continue;
+        const double friction = mFrictionDamping[i];
+        const bool inside = mFoundInside[i];
+        setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, false);
+        mContactMu[i] = c.friction;
+        if (friction > 0.0) slide(i, friction);
+        mFoundInside[i] = inside;
+        ++changes;
+    }
     for (size_t k = 0; k < mKin.colliders.size(); ++k) {
         const Collider& c = (*env.colliders)[k];
         const double thick = mKin.colliders[k].thickness;
@@ -460,14 +497,23 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             ContactPoint cp;
             bool found = endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
                          cp.distance < thick - kContactSlop;
-            // An open surface (MovingMeshContact::openSurface: a cloth the hair meets) the step's
-            // path went through, ending beyond it (its unsigned distance there can exceed ξ: the
-            // query above misses it): the continuous pass's vertex test, the face it met as a plane
-            // at the step's end (moving_collider.h, sweptContact), is the contact, so that the
-            // solve, not the pass after it, stops the vertex on its side.
-            if (!found && c.moving && c.moving->openSurface())
-                found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
-                        cp.distance < 0.0;
+            // A moving mesh the step's path went into or through, ending beyond the face it met
+            // (its unsigned distance there can exceed ξ: the query above misses it — a body
+            // turning into hair, an open cloth under it): the continuous pass's vertex test, the
+            // face it met as a plane at the step's end (moving_collider.h, sweptContact), is the
+            // contact, so that the solve, not the pass after it, stops the vertex on its side
+            // (the pass placed such a vertex back at the point it met, its slide over the step
+            // lost: a hair segment on a fast-turning head squashed to 0.81× its length). A path
+            // found clear is not swept again while the solve's rounds leave its end where it was.
+            if (!found && c.moving && c.moving->openSurface()) {
+                const size_t slot = k * n + i;
+                if (!(mSweptClear[slot] == 1 && vec3At(mSweptAt.data(), slot) == x1)) {
+                    found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
+                            cp.distance < 0.0;
+                    mSweptClear[slot] = found ? 0 : 1;
+                    vec3At(mSweptAt.data(), slot) = x1;
+                }
+            }
             Vec3 at = x1;
             const ColliderPose& pose = mKin.colliders[k].end;
             if (!found) {
