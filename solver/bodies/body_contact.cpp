@@ -491,26 +491,37 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         };
         std::vector<NewContact> made;
         for (size_t i = 0; i < n; ++i) {
-            if (mConstraints.kind[i] != 0 || mReleased[i]) continue;
+            if (mConstraints.kind[i] != 0) continue;
+            // A contact released in this substep is not made again from its end query (its
+            // force pulled: it leaves), only from the moving mesh's continuous test below.
+            const bool released = mReleased[i];
+            if (released && !c.moving) continue;
             const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
             const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
             ContactPoint cp;
-            bool found = endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
+            bool found = !released && endPoseQuery(k, i, x1, thick - kContactSlop, cp) &&
                          cp.distance < thick - kContactSlop;
-            // A moving mesh the step's path went into or through, ending beyond the face it met
-            // (its unsigned distance there can exceed ξ: the query above misses it — a body
-            // turning into hair, an open cloth under it): the continuous pass's vertex test, the
-            // face it met as a plane at the step's end (moving_collider.h, sweptContact), is the
-            // contact, so that the solve, not the pass after it, stops the vertex on its side
-            // (the pass placed such a vertex back at the point it met, its slide over the step
-            // lost: a hair segment on a fast-turning head squashed to 0.81× its length). A path
-            // found clear is not swept again while the solve's rounds leave its end where it was.
-            if (!found && c.moving && c.moving->openSurface()) {
+            // A moving mesh the step's path went through, ending beyond the face it met: the
+            // continuous pass's vertex test, the face it met as a plane at the step's end
+            // (moving_collider.h, sweptContact), is the contact, so that the solve, not the pass
+            // after it, stops the vertex on its side. Asked of
+            // - an open surface (MovingMeshContact::openSurface: a cloth the hair meets), whose
+            //   unsigned distance there can exceed ξ (the query above misses it);
+            // - a vertex released in an earlier round that a later solve carried more than ξ/4
+            //   behind the face it met (a head turning into hair whose contact pulled at first):
+            //   the pass put it back at the point it met, its slide over the step lost, a segment
+            //   squashed to 0.93×. Made again as found inside, it is not released again.
+            // A path found clear is not swept again while the rounds leave its end where it was.
+            if (!found && c.moving && (released || c.moving->openSurface())) {
                 const size_t slot = k * n + i;
-                if (!(mSweptClear[slot] == 1 && vec3At(mSweptAt.data(), slot) == x1)) {
+                // mSweptClear: 1 clear of any end behind a face met, 2 of one deeper than ξ/4.
+                const uint8_t clear = mSweptClear[slot];
+                if (!((released ? clear >= 1 : clear == 1) &&
+                      vec3At(mSweptAt.data(), slot) == x1)) {
+                    const double depth = released ? kReplaneDepth * thick : 0.0;
                     found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
-                            cp.distance < 0.0;
-                    mSweptClear[slot] = found ? 0 : 1;
+                            cp.distance < -depth;
+                    mSweptClear[slot] = found ? 0 : released ? 2 : 1;
                     vec3At(mSweptAt.data(), slot) = x1;
                 }
             }
