@@ -701,7 +701,7 @@ private:
         const json run = json::parse(text, nullptr, false);
         if (run.is_discarded() || !run.is_object())
             return reply(res, json{{"status", "starting"}, {"frames", json::array()}});
-        const double overStretch = run.value("/settings/solver/over_stretch"_json_pointer, 3.0);
+        const double overStretch = run.value("/settings/solver/over_stretch"_json_pointer, 1.5);
         json frames = json::array();
         for (const json& f : run.value("frames", json::array())) {
             long contacts = 0, halved = 0, recovered = 0;

@@ -106,7 +106,7 @@ struct HairSpec {
 // [solver]: the robustness limits (defaults in world.h / body.h).
 struct SolverSection {
     int maxHalvings = 6;
-    double overStretch = 3.0;
+    double overStretch = 1.5;
     double velocityJump = 50.0;
     // The response to a substep in trouble (solver::WorldSettings::retry*, growBack,
     // strainLimitRetry; the defaults are WorldSettings').

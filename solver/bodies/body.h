@@ -199,7 +199,7 @@ struct SubstepStatus {
 
 // Limits of the trouble detectors.
 struct TroubleLimits {
-    double overStretch = 3.0;   // edge length / rest length that counts as over-stretched
+    double overStretch = 1.5;   // edge length / rest length that counts as over-stretched
     double velocityJump = 50.0; // m/s: a |Δv| larger than this and than 2× the speed scale
 };
 

@@ -1,8 +1,9 @@
 # Frame-end trouble and `gale sim --strict` (../shared/spec/cli.md, "Shots"): a strip of 11 × 2
 # vertices 5 cm apart, every vertex pinned, whose mesh has its right half moved 15 cm away from
 # its rest mesh (rest_mesh), so that its two middle edges are held at 20/5 = 4× their rest length
-# (closed form), past over_stretch = 3, from frame 2 on (frame 1 is the initial state); the
-# diagonals beside them are at 2.92× and every other edge at rest. The scene forced it (both
+# (closed form), past over_stretch = 1.5 (the default), from frame 2 on (frame 1 is the initial
+# state); the diagonal between them is at √(0.2² + 0.05²)/√(2 · 0.05²) = 2.92×, past it too (three
+# edges), and every other edge at rest. The scene forced it (both
 # ends of the edges are pinned), and says so. Without --strict: exit 0, a warning per frame on
 # stderr and run.json's "trouble" entries; with --strict: exit 4 at frame 2, frame 1 written and
 # not 2, run.json status "trouble"; over_stretch = 5 makes the same run clean.
@@ -40,7 +41,7 @@ echo '[0, 0, 0]' > calm.se
 
 run "$GALE" sim scene.toml -o plain
 expect_rc 0 "gale sim without --strict"
-expect_match "$ERR" "gale: warning: frame 2: strip: over-stretched: edge (5-6|16-17) at 4× its rest length \(limit 3×\) at \(0\.35, 1(\.05)?, 0\) \(2 edges past the limit\), forced by pins \(the scene's" "a warning names the edge, its stretch, where, and the pins"
+expect_match "$ERR" "gale: warning: frame 2: strip: over-stretched: edge (5-6|16-17) at 4× its rest length \(limit 1\.5×\) at \(0\.35, 1(\.05)?, 0\) \(3 edges past the limit\), forced by pins \(the scene's" "a warning names the edge, its stretch, where, and the pins"
 [ -f plain/strip.0004.obj ] || fail "without --strict every frame is written"
 python3 - plain/run.json <<'PY' || fail "run.json's trouble entries"
 import json, sys
@@ -53,8 +54,8 @@ for F in (2, 3, 4):
     assert len(t) == 1 and t[0]["kind"] == "over_stretch", t
     t = t[0]
     assert abs(t["stretch"] - 4.0) < 1e-5, t                      # 0.20 m / 0.05 m
-    assert t["limit"] == 3 and t["scene"] is True and t["forced_by"] == "pins", t
-    assert abs(t["position"][0] - 0.35) < 1e-6 and t["count"] == 2, t  # the middle edges
+    assert t["limit"] == 1.5 and t["scene"] is True and t["forced_by"] == "pins", t
+    assert abs(t["position"][0] - 0.35) < 1e-6 and t["count"] == 3, t  # the middle edges, a diagonal
     assert {t["vertex"], t["other_vertex"]} in ({5, 6}, {16, 17}), t
     assert any(e.startswith("trouble: over-stretched") for e in by[F]["events"]), by[F]["events"]
 PY

@@ -205,7 +205,7 @@ get "$(tok "/api/frame?n=1")"
 expect "$(json '[max(abs(x) for x in o["strain"]) for o in d["objects"]], len(d["objects"][0]["strain"]) * 3 == len(d["objects"][0]["points"])')" \
     "([0.0], True)" "frame 1 is the rest shape: no strain, one value per vertex"
 for _ in $(seq 50); do get "$(tok /api/run)"; [ "$(json 'd["status"]')" = ok ] && break; sleep 0.1; done
-expect "$(json 'd["status"], [f["frame"] for f in d["frames"]], d["overStretch"]')" "('ok', [1, 2, 3, 4, 5, 6], 3.0)" "run.json's frames"
+expect "$(json 'd["status"], [f["frame"] for f in d["frames"]], d["overStretch"]')" "('ok', [1, 2, 3, 4, 5, 6], 1.5)" "run.json's frames (over_stretch, the default)"
 sed -i 's/^frames = \[1, 6\]/frames = [1, 2000]/' "$TOML"
 sleep 0.3
 post /api/simulate '{"action": "start"}'
