@@ -22,6 +22,10 @@ namespace {
 
 // How far the body may stretch or compress an attached edge before runWarnings says so.
 constexpr double kBindingLimit = 0.10;
+// How far from the body's surface an attached vertex may be bound before runWarnings says so:
+// the larger of kBindGapFloor (m) and kBindGapShare of the cloth's (or hair's) extent.
+constexpr double kBindGapFloor = 0.05;
+constexpr double kBindGapShare = 0.25;
 // How deep inside a collider a pin may hold a vertex before runWarnings says so (m).
 constexpr double kPinDepth = 0.01;
 
@@ -136,6 +140,48 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
                 scene.wind.path, spec.attach,
                 "[[hair]] '" + spec.name + "' attach: it selects no root: check the box", true));
     }
+    // Attachments bound far from the body: the cloth is not where the body is at the frame the
+    // binding is made (a cape exported in centimetres onto a body in metres: bound 148 m off;
+    // a body whose first frame stands far from its rest pose, without a pre-roll: 1.8 m off).
+    // The binding holds that offset for the whole run, so the cloth rides beside the body.
+    const auto boundFar = [&](const solver::Body& body, const std::string& what,
+                              const PinSpec& key) {
+        std::vector<std::pair<int, double>> gaps;
+        body.attachmentGaps(gaps);
+        if (gaps.empty()) return;
+        const auto worst =
+            std::max_element(gaps.begin(), gaps.end(),
+                             [](const auto& a, const auto& b) { return a.second < b.second; });
+        std::vector<double> x(body.positions().data(),
+                              body.positions().data() + body.positions().size());
+        const double extent = boxOf(x).extent();
+        if (!(worst->second > std::max(kBindGapFloor, kBindGapShare * extent))) return;
+        size_t far = 0;
+        for (const auto& g : gaps)
+            far += g.second > std::max(kBindGapFloor, kBindGapShare * extent);
+        const char* kind = what.rfind("[[hair]]", 0) == 0 ? "hair" : "cloth";
+        out.push_back(specError(
+            scene.wind.path, key,
+            what + " attach: vertex " + std::to_string(worst->first) + " is bound " +
+                metres(worst->second) + " m from the body's surface at frame " +
+                std::to_string(first) + " (" + std::to_string(far) + " of " +
+                std::to_string(gaps.size()) + " bound vertices farther than " +
+                metres(std::max(kBindGapFloor, kBindGapShare * extent)) + " m; the " + kind +
+                " spans " + metres(extent) +
+                " m): it rides that far beside the body all run; are the two "
+                "in the same units, and does the body stand where the " +
+                kind +
+                " was modelled at that frame (scene.preroll eases it there from its rest pose)?",
+            true));
+    };
+    for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i)
+        if (scene.cloths[i].hasAttach)
+            boundFar(*bodies[i], "[[cloth]] '" + scene.cloths[i].name + "'",
+                     scene.cloths[i].attach);
+    for (size_t j = 0; j < scene.hairs.size() && scene.cloths.size() + j < bodies.size(); ++j)
+        if (scene.hairs[j].hasAttach)
+            boundFar(*bodies[scene.cloths.size() + j], "[[hair]] '" + scene.hairs[j].name + "'",
+                     scene.hairs[j].attach);
     // Attached edges (both ends bound to a body's surface) that the body's motion stretches or
     // compresses past kBindingLimit over the run's frames: the cloth there cannot do better than
     // the skin (hard) or fights it (soft).

@@ -186,6 +186,13 @@ void Body::attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) c
         out.emplace_back(s.vertex, boundPosition(*mPinSets[s.set].attach, *s.binding, t));
 }
 
+void Body::attachmentGaps(std::vector<std::pair<int, double>>& out) const {
+    out.clear();
+    for (size_t k = 0; k < mPinned.size(); ++k)
+        if (mPinBinding[k]) out.emplace_back(mPinned[k], mPinBinding[k]->distance);
+    for (const SoftAttachment& s : mSoft) out.emplace_back(s.vertex, s.binding->distance);
+}
+
 void Body::addSoftAttachments(const ForceInput& in, ForceOutput& out, bool matrix) const {
     const double h = in.h, t = in.t + in.h;
     for (const SoftAttachment& s : mSoft) {

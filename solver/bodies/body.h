@@ -337,6 +337,9 @@ public:
     double edgeStretchOf(const VecX& x, size_t e) const;
     // Every vertex bound to a body's surface (hard and soft attachments) and its bound point at t.
     void attachmentTargets(double t, std::vector<std::pair<int, Vec3>>& out) const;
+    // Every vertex bound to a body's surface and its distance (m) to that surface at the bind
+    // pose (SurfaceBinding::distance): how far from the body the cloth was when it was bound.
+    void attachmentGaps(std::vector<std::pair<int, double>>& out) const;
     // The pin and attachment sets as added (addPins), in order.
     const std::vector<PinSet>& pinSets() const { return mPinSets; }
     // The colliders will not be where the last substep left them at its end (a collider made

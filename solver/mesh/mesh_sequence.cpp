@@ -291,6 +291,7 @@ SurfaceBinding bindToSurface(const MeshSequence& mesh, const Vec3& x, double whe
         }
     }
     if (b.triangle < 0) return b;
+    b.distance = std::sqrt(best);
     const auto& t = mesh.triangles()[b.triangle];
     const Vec3 a = pos(t[0]), bb = pos(t[1]), c = pos(t[2]);
     const Vec3 nf = unitFaceNormal(a, bb, c);

@@ -101,6 +101,7 @@ struct SurfaceBinding {
     double w[3] = {0, 0, 0};
     double height = 0.0;
     bool alongFace = false;
+    double distance = 0.0; // m: the point's distance to the surface at the bind pose
 };
 // `t` (s): the time of the pose it binds against, the body interpolated there (NaN: the
 // sequence's first file).

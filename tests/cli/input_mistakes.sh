@@ -4,6 +4,8 @@
 #   precision: an error at its line and column (tinyobjloader alone reads them as 0 or inf);
 # - a body that only an attachment names, whose sequence is shorter than the run or in
 #   centimetres: the warnings a collider gets, at the attach key;
+# - an attachment bound far from its body's surface (units, or a body far from where the cloth
+#   was modelled at the binding's frame): a warning at the attach key;
 # - a frame pattern that matches one file: the body would stand still, said at the key;
 # - a frame file that is a link to nothing (an unmounted cache): an error naming the link;
 # - another program's frame token (${F4}): the error lists the tokens gale reads;
@@ -37,9 +39,12 @@ grid('cape.obj', 6, 0.3, 0.75)
 os.makedirs('body', exist_ok=True)
 os.makedirs('cm', exist_ok=True)
 os.makedirs('one', exist_ok=True)
-for f in range(1, 6):
-    box('body/box.%04d.obj' % f, 0.02 * f)
-    box('cm/box.%04d.obj' % f, 0.02 * f, 100.0)
+os.makedirs('far', exist_ok=True)
+for f in range(1, 9):
+    if f < 6:
+        box('body/box.%04d.obj' % f, 0.02 * f)
+        box('cm/box.%04d.obj' % f, 0.02 * f, 100.0)
+    box('far/box.%04d.obj' % f, 2.0 + 0.02 * f)
 box('one/box.0001.obj', 0.0)
 PY
 scene() { # ATTACH_MESH [EXTRA]
@@ -84,6 +89,19 @@ run "$GALE" check one.toml
 expect_rc 0 "a one-file sequence (a warning)"
 expect_match "$ERR" "one.toml:9:[0-9]+: warning: .*matches one file \(frame 1\), so the body stands still" \
     "a pattern that matches one file is warned of"
+
+# An attachment bound far from its body: the box stands 2 m to the side of the cape at frame 1
+# (x from 1.82 to 2.22), so the cape's top row (y = 1.05, 1 cm in front of the box's face when it
+# is in place) is bound up to 1.82 + 0.15 = 1.97 m from its surface (the vertex at x = −0.15,
+# against the box's left face). The boxes in place say nothing of it.
+scene "far/box.#.obj" > far.toml
+run "$GALE" check far.toml
+expect_rc 0 "an attachment bound far from its body (a warning)"
+expect_match "$ERR" "far.toml:9:[0-9]+: warning: .*attach: vertex [0-9]+ is bound 1\.97 m from the body's surface at frame 1 \(7 of 7 bound vertices" \
+    "the far binding is warned of at the attach key, with its distance"
+scene "body/box.#.obj" > near.toml
+run "$GALE" check near.toml --set scene.frames=[1,5]
+expect_no_match "$ERR" "is bound" "a cape bound 1 cm off its body: no warning"
 
 # A frame linked to a cache that is not there.
 mkdir -p linked
