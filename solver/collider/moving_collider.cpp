@@ -31,6 +31,7 @@
 
 #include "solver/collider/collider.h"
 #include "solver/contact/ccd.h"
+#include "solver/contact/intersect.h"
 #include "solver/mesh/mesh.h"
 
 #include <algorithm>
@@ -377,6 +378,35 @@ MovingMeshContact::firstVertexHit(const Vec3& p0, const Vec3& p1, const std::vec
     if (!interior) hit.normal = nt.normalized();
     hit.point = w[0] * corner(true, t[0]) + w[1] * corner(true, t[1]) + w[2] * corner(true, t[2]);
     return hit;
+}
+
+int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to,
+                                           std::vector<int>* which) const {
+    if (!mBuilt || from.size() != to.size()) return 0;
+    const auto& tris = mMesh->triangles();
+    int count = 0;
+    std::vector<int> cand;
+    for (Eigen::Index i = 0; 3 * i + 2 < from.size(); ++i) {
+        const Vec3 a = vec3At(from.data(), i), b = vec3At(to.data(), i);
+        if (a == b || !a.allFinite() || !b.allFinite()) continue;
+        // The segment's box at the end pose, in the trees' frame (endQuery), whose boxes hold
+        // every triangle at the step's end.
+        contact::Box q;
+        q.add(endQuery(a));
+        q.add(endQuery(b));
+        cand.clear();
+        mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
+        for (int k : cand) {
+            const auto& t = tris[k];
+            if (contact::segmentCrossesTriangle(a, b, corner(true, t[0]), corner(true, t[1]),
+                                                corner(true, t[2]))) {
+                ++count;
+                if (which) which->push_back(static_cast<int>(i));
+                break;
+            }
+        }
+    }
+    return count;
 }
 
 bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thickness,

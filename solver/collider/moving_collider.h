@@ -82,6 +82,13 @@ public:
               const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
               double h, int passes = 4);
 
+    // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
+    // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
+    // between the two points). `which` (optional) gets them. Vertices that did not move are not
+    // tested.
+    int movesThroughSurface(const VecX& from, const VecX& to,
+                            std::vector<int>* which = nullptr) const;
+
     // The vertex test of the continuous pass for a path p0 → p1 over the prepared step, as a
     // contact plane for the solve: when the path comes within ξ/2 of the surface (a crossing
     // too), the face it met first, at the step's end — `out.normal` its normal on the side the

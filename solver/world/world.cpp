@@ -212,6 +212,14 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             stepBody(body, t0, dt, substeps, end, runs[k], fs.bodies[mSelfBodies[k]], own);
             stretchBefore[k] = body.maxEdgeStretch();
         }
+        // The cloth as its solve and the colliders' passes left it (the pass after it moves
+        // vertices that no collider saw).
+        bool moving = false;
+        for (const Collider& c : mColliders) moving = moving || c.moving;
+        std::vector<VecX> solved;
+        if (moving)
+            for (size_t k = 0; k < n && k < mClothBodies; ++k)
+                solved.push_back(mBodies[mSelfBodies[k]]->positions());
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
         bool stretched = false;
@@ -223,6 +231,37 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
                 after > body.limits().overStretch)
                 stretched = true;
+        }
+        // A pass that pushed cloth through a moving body's surface (a fold pressed between the
+        // cloth and a turning head: its corrections moved vertices into the body, which nothing
+        // pushed out again, and the cape stayed inside the head for the rest of the shot) is
+        // answered as a pass that stretched: the interval again at half the step, whose smaller
+        // motions the pass corrects less.
+        int pushedIn = 0;
+        for (size_t k = 0; k < solved.size(); ++k)
+            for (const Collider& c : mColliders)
+                if (c.moving && std::abs(c.moving->t1() - tEnd) <= 1e-9 * std::max(1.0, tEnd))
+                    pushedIn += c.moving->movesThroughSurface(solved[k],
+                                                              mBodies[mSelfBodies[k]]->positions());
+        if (pushedIn > 0 && level < maxLevel) {
+            for (size_t k = 0; k < n; ++k) {
+                mBodies[mSelfBodies[k]]->restore(snaps[k]);
+                BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
+                ++stats.rejected;
+                stats.deepestHalving = std::max(stats.deepestHalving, level + 1);
+            }
+            runs = runsBefore;
+            ++level;
+            streak = 0;
+            held = mClothPlanes;
+            retried = false;
+            ++fs.selfContacts.halvings;
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision pushed %d cloth vertex(es) through a moving "
+                          "body's surface; substep halved to %.6g s",
+                          tEnd, pushedIn, dt / substeps / static_cast<double>(1L << level));
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+            continue;
         }
         // First, the same interval again with the pairs the pass found as contact planes in
         // its solve (SelfCollision::retryPlanes): the solve then holds them and spreads what the
