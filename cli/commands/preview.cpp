@@ -268,9 +268,19 @@ int runVizFrames(const VizOptions& o) {
     SourceOptions source = o.source;
     const std::vector<std::string> runSets = recordedSets(dir);
     if (!runSets.empty()) {
-        std::cerr << "gale: drawing the scene with the run's overrides:";
-        for (const std::string& s : runSets) std::cerr << " --set " << s;
-        std::cerr << '\n';
+        // Said as applied: a key given here again wins over the run's (it comes later).
+        const auto keyOf = [](const std::string& set) { return set.substr(0, set.find('=')); };
+        std::string kept, replaced;
+        for (const std::string& s : runSets) {
+            const bool again =
+                std::any_of(o.source.sets.begin(), o.source.sets.end(),
+                            [&](const std::string& mine) { return keyOf(mine) == keyOf(s); });
+            (again ? replaced : kept) += " --set " + s;
+        }
+        if (!kept.empty())
+            std::cerr << "gale: drawing the scene with the run's overrides:" << kept << '\n';
+        if (!replaced.empty())
+            std::cerr << "gale: the run's" << replaced << " replaced by this command's --set\n";
         source.sets.insert(source.sets.begin(), runSets.begin(), runSets.end());
     }
     FieldInput input;

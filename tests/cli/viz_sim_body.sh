@@ -36,6 +36,12 @@ expect_match "$(head -c 300 out/run.json)" '"sets": \["windicator.speed=6"\]' "r
 run "$GALE" viz scene.toml --sim out --frames 2,8 --plane y=1 --style none --no-field -o 'p.#.svg' --size 320x320
 expect_rc 0 "pictures of two frames"
 expect_match "$ERR" "with the run's overrides: --set windicator.speed=6" "the run's overrides are applied again ($ERR)"
+# The same key given here wins, and the message says so (it does not claim the run's value).
+run "$GALE" viz scene.toml --sim out --frames 2 --plane y=1 --style none --no-field -o 'q.#.svg' --size 320x320 \
+    --set windicator.speed=2
+expect_rc 0 "a picture with the wind speed given again"
+expect_no_match "$ERR" "with the run's overrides" "no claim that the run's speed is drawn ($ERR)"
+expect_match "$ERR" "the run's --set windicator.speed=6 replaced by this command's --set" "the replaced override is said"
 # The body's fills are grey: red = green, blue a little below (cloth is blue, text and frame
 # are blue-grey). Their leftmost x in the picture follows the body, which moved 0.3 m along +x.
 body_left() {
