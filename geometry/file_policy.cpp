@@ -146,10 +146,7 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         if (ec || !fs::exists(st)) {
             error = "cannot read '" + name + "' (" + resolved + "): " + std::strerror(ENOENT);
             // Another program's frame token (${F4}, @, %-4d, <f>): say which ones gale reads.
-            if (file.find_first_of("%@<") != std::string::npos ||
-                file.find('$') != std::string::npos)
-                error += std::string("; if it names a frame sequence, write the frame number as ") +
-                         io::kFrameTokens;
+            error += io::foreignTokenHint(file);
             return false;
         }
         if (fs::is_directory(st)) {

@@ -59,6 +59,11 @@ bool hasFrameToken(const std::string& name) {
     return false;
 }
 
+std::string foreignTokenHint(const std::string& fileName) {
+    if (fileName.find_first_of("%@<{$") == std::string::npos) return "";
+    return std::string("; if it names a frame sequence, write the frame number as ") + kFrameTokens;
+}
+
 bool parseFramePattern(const std::string& name, FramePattern& out, std::string* error) {
     bool found = false;
     for (size_t i = 0; i < name.size();) {

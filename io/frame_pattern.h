@@ -16,6 +16,11 @@ struct FramePattern {
     bool signInWidth = false;   // %04d: printf's width counts the sign (frame -1 is -001)
 };
 
+// For a file that could not be read: when its name looks like another program's frame token
+// (${F4}, @, %-4d, <f>, {frame:04d}), "; if it names a frame sequence, write the frame number as
+// ..." (gale's tokens); otherwise empty.
+std::string foreignTokenHint(const std::string& fileName);
+
 // True when `name` holds a frame token anywhere (a sequence rather than a single file).
 bool hasFrameToken(const std::string& name);
 

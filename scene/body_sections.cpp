@@ -690,12 +690,20 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
         c.moving = std::make_shared<MovingMeshContact>(std::move(seq));
         return;
     }
+    // A static mesh: one file. When it cannot be read, that is the error (a name with another
+    // program's frame token, body.<F>.obj, is said with gale's tokens), not a rest_mesh beside it.
+    c.mesh = MeshCollider::load(path, voxel, problem);
+    if (!c.mesh) {
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec))
+            problem += io::foreignTokenHint(std::filesystem::path(file).filename().string());
+        error(*mesh, what + ": " + problem);
+        return;
+    }
     if (const toml::node* r = t.get("rest_mesh"))
         error(*r, what +
                       ": rest_mesh is the rest pose of a mesh sequence ('#', %04d or $F4 in mesh); "
                       "a static mesh does not move");
-    c.mesh = MeshCollider::load(path, voxel, problem);
-    if (!c.mesh) error(*mesh, what + ": " + problem);
 }
 
 void Loader::loadSolver(const toml::table& t, SolverSection& s) {

@@ -8,7 +8,8 @@
 #   was modelled at the binding's frame): a warning at the attach key;
 # - a frame pattern that matches one file: the body would stand still, said at the key;
 # - a frame file that is a link to nothing (an unmounted cache): an error naming the link;
-# - another program's frame token (${F4}): the error lists the tokens gale reads;
+# - another program's frame token (${F4} in an attachment, <F> or {frame:04d} in a collider,
+#   with or without a rest_mesh): the error lists the tokens gale reads;
 # - an attachment whose box selects nothing: a warning at the attach key; a --set attach mesh
 #   that cannot be read: an error at that --set;
 # - held vertices the scene pulls apart (a pinned edge and an attached edge 1 m apart): the
@@ -119,6 +120,19 @@ scene 'body/box.${F4}.obj' > braces.toml
 run "$GALE" check braces.toml
 expect_rc 1 "an unknown frame token"
 expect_match "$ERR" "write the frame number as .*#.*%04d.*\\\$F4" "the error lists the tokens gale reads"
+# A collider named with another program's token (read as one static file that is not there):
+# the same list, at the collider's mesh key; with a rest_mesh beside it, still the mesh's error.
+for token in '<F>' '{frame:04d}'; do
+    { scene body/box.#.obj; printf '\n[[collider]]\nname = "b"\ntype = "mesh"\nmesh = "body/box.%s.obj"\n' "$token"; } > tok.toml
+    for rest in "" 'rest_mesh = "body/box.0001.obj"'; do
+        { cat tok.toml; echo "$rest"; } > tok2.toml
+        run "$GALE" check tok2.toml
+        expect_rc 1 "a collider's sequence written box.$token.obj ${rest:+(with a rest_mesh)}"
+        expect_match "$ERR" "tok2.toml:15:[0-9]+: error: .*cannot read 'body/box\.$token\.obj'.*write the frame number as .*#.*%04d" \
+            "the collider's error lists the tokens gale reads ($token${rest:+, with a rest_mesh})"
+        expect_no_match "$ERR" "a static mesh does not move" "no rest_mesh error hides it ($token)"
+    done
+done
 
 # A --set that names a mesh that is not there: said at the --set, not at the scene's attach line.
 run "$GALE" check short.toml --set cloth.c.attach.mesh=nowhere.obj
