@@ -224,10 +224,14 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         fs.selfContacts.add(st);
         bool stretched = false;
         double worst = 0.0;
+        std::string worstName; // the body the pass stretched most (cloth or hair)
         for (size_t k = 0; k < n; ++k) {
             Body& body = *mBodies[mSelfBodies[k]];
             const double after = body.maxEdgeStretch();
-            worst = std::max(worst, after);
+            if (after > worst) {
+                worst = after;
+                worstName = body.name();
+            }
             if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
                 after > body.limits().overStretch)
                 stretched = true;
@@ -302,9 +306,10 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             retried = false;
             ++fs.selfContacts.halvings;
             std::snprintf(buf, sizeof buf,
-                          "t=%.6g s: self-collision stretched cloth to %.3g × its rest length; "
+                          "t=%.6g s: self-collision stretched '%s' to %.3g × its rest length; "
                           "substep halved to %.6g s",
-                          tEnd, worst, dt / substeps / static_cast<double>(1L << level));
+                          tEnd, worstName.c_str(), worst,
+                          dt / substeps / static_cast<double>(1L << level));
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
             continue;
         }
