@@ -247,7 +247,9 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 if (c.moving && std::abs(c.moving->t1() - tEnd) <= 1e-9 * std::max(1.0, tEnd))
                     pushedIn += c.moving->movesThroughSurface(solved[k],
                                                               mBodies[mSelfBodies[k]]->positions());
-        if (pushedIn > 0 && level < maxLevel) {
+        // The interval undone and redone at half the step, the event `why` (its halved step
+        // appended) for every colliding body.
+        const auto halve = [&](const std::string& why) {
             for (size_t k = 0; k < n; ++k) {
                 mBodies[mSelfBodies[k]]->restore(snaps[k]);
                 BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
@@ -260,11 +262,13 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             held = mClothPlanes;
             retried = false;
             ++fs.selfContacts.halvings;
-            std::snprintf(buf, sizeof buf,
-                          "t=%.6g s: self-collision pushed %d cloth vertex(es) through a moving "
-                          "body's surface; substep halved to %.6g s",
-                          tEnd, pushedIn, dt / substeps / static_cast<double>(1L << level));
+            std::snprintf(buf, sizeof buf, "t=%.6g s: %s; substep halved to %.6g s", tEnd,
+                          why.c_str(), dt / substeps / static_cast<double>(1L << level));
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+        };
+        if (pushedIn > 0 && level < maxLevel) {
+            halve("self-collision pushed " + std::to_string(pushedIn) +
+                  " cloth vertex(es) through a moving body's surface");
             continue;
         }
         // First, the same interval again with the pairs the pass found as contact planes in
@@ -293,24 +297,11 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             }
         }
         if (stretched && level < maxLevel) {
-            for (size_t k = 0; k < n; ++k) {
-                mBodies[mSelfBodies[k]]->restore(snaps[k]);
-                BodyFrameStats& stats = fs.bodies[mSelfBodies[k]];
-                ++stats.rejected;
-                stats.deepestHalving = std::max(stats.deepestHalving, level + 1);
-            }
-            runs = runsBefore;
-            ++level;
-            streak = 0;
-            held = mClothPlanes;
-            retried = false;
-            ++fs.selfContacts.halvings;
-            std::snprintf(buf, sizeof buf,
-                          "t=%.6g s: self-collision stretched '%s' to %.3g × its rest length; "
-                          "substep halved to %.6g s",
-                          tEnd, worstName.c_str(), worst,
-                          dt / substeps / static_cast<double>(1L << level));
-            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
+            char what[160];
+            std::snprintf(what, sizeof what,
+                          "self-collision stretched '%s' to %.3g × its rest length",
+                          worstName.c_str(), worst);
+            halve(what);
             continue;
         }
         if (st.unresolved > 0) {
