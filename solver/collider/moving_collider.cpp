@@ -102,6 +102,21 @@ double boxGap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi
 MovingMeshContact::MovingMeshContact(std::shared_ptr<const MeshSequence> mesh)
     : mMesh(std::move(mesh)) {
     mEdges = meshEdges(mMesh->triangles());
+    // Closed: 3 T = 2 E with every edge used twice (counted per edge below).
+    {
+        std::vector<std::array<int, 2>> all;
+        for (const auto& t : mMesh->triangles())
+            for (int k = 0; k < 3; ++k)
+                all.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+        std::sort(all.begin(), all.end());
+        mClosed = !all.empty();
+        for (size_t i = 0; i < all.size() && mClosed;) {
+            size_t j = i;
+            while (j < all.size() && all[j] == all[i]) ++j;
+            mClosed = j - i == 2;
+            i = j;
+        }
+    }
     std::vector<uint8_t> used(mMesh->vertexCount(), 0);
     for (const auto& t : mMesh->triangles())
         for (int v : t)
@@ -148,6 +163,8 @@ void MovingMeshContact::prepare(double t0, double t1) {
     mMesh->positionsAt(t1, mP1);
     mT0 = t0;
     mT1 = t1;
+    mEndBox = contact::Box();
+    for (int v : mVertices) mEndBox.add(corner(true, v));
     // The body's mean displacement over the step: the trees' frame moves with it (mShift).
     Vec3 shift = Vec3::Zero();
     for (int v : mVertices) shift += corner(true, v) - corner(false, v);
@@ -407,6 +424,40 @@ int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to,
         }
     }
     return count;
+}
+
+double MovingMeshContact::insideDepth(const Vec3& x) const {
+    if (!mBuilt || !mClosed || !x.allFinite()) return 0.0;
+    const auto& tris = mMesh->triangles();
+    // The surface's box at the end (prepare()); a point outside it is outside.
+    const contact::Box& box = mEndBox;
+    if ((x.array() < box.lo.array()).any() || (x.array() > box.hi.array()).any()) return 0.0;
+    // A ray out through the box's nearest face (the fewest triangles on its way), along a
+    // direction tilted off the axes so that no mesh is aligned with it (a crossing exactly
+    // through an edge or a vertex, counted twice, is then a measure-zero event).
+    int axis = 0;
+    double sign = 1.0, nearest = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        if (box.hi[a] - x[a] < nearest) nearest = box.hi[a] - x[a], axis = a, sign = 1.0;
+        if (x[a] - box.lo[a] < nearest) nearest = x[a] - box.lo[a], axis = a, sign = -1.0;
+    }
+    Vec3 dir(0.0130986, 0.0217538, 0.0174322);
+    dir[axis] = sign;
+    const double reach = (box.hi - box.lo).norm() + 1e-3;
+    const Vec3 end = x + reach * dir.normalized();
+    contact::Box q;
+    q.add(endQuery(x));
+    q.add(endQuery(end));
+    int crossings = 0;
+    mBvh.queryEach(inTrees(q), [&](int k) {
+        const auto& t = tris[k];
+        if (contact::segmentCrossesTriangle(x, end, corner(true, t[0]), corner(true, t[1]),
+                                            corner(true, t[2])))
+            ++crossings;
+    });
+    if (crossings % 2 == 0) return 0.0;
+    ContactPoint cp;
+    return closest(x, true, INFINITY, cp) ? std::max(cp.distance, 1e-12) : 1e-12;
 }
 
 bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thickness,

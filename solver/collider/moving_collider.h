@@ -96,6 +96,14 @@ public:
     // beyond it), the surface velocity there. False when the path meets nothing.
     bool sweptContact(const Vec3& p0, const Vec3& p1, double thickness, ContactPoint& out) const;
 
+    // Whether the surface is closed (every edge shared by exactly two triangles): it has an
+    // inside, and insideDepth() can tell it.
+    bool closed() const { return mClosed; }
+    // For a closed surface, at the end of the prepared step: how deep x is inside it (m, its
+    // distance to the surface), or a value ≤ 0 when it is outside (or the surface is not
+    // closed). Inside is an odd number of crossings of a ray from x to beyond the surface's box.
+    double insideDepth(const Vec3& x) const;
+
     // An open surface (a cloth as the hair's collider, World::clothAsColliders) rather than a
     // body: the solve also tests vertex paths for crossing it (Body::updateContacts, an unsigned
     // distance cannot tell), and a vertex hit in sweep() keeps its slide along the face, cut by
@@ -164,6 +172,8 @@ private:
     std::shared_ptr<const MeshSequence> mMesh;
     bool mOpen = false;                     // setOpenSurface
     std::vector<std::array<int, 2>> mEdges; // unique body edges
+    bool mClosed = false;                   // every edge in exactly two triangles
+    contact::Box mEndBox;                   // the corners at t1 (prepare; insideDepth)
     std::vector<int> mVertices;             // body vertices in some triangle
     std::vector<double> mP0, mP1;           // corners at t0 and t1
     // The body's mean displacement over the step (m). The trees hold every primitive swept in

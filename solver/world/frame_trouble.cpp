@@ -1,6 +1,7 @@
 // Frame-end trouble (frame_trouble.h): the most stretched edge past over_stretch and the deepest
 // vertex inside each collider, with what held or pushed them there.
 #include "solver/world/frame_trouble.h"
+#include "solver/collider/moving_collider.h"
 
 #include <cmath>
 #include <cstdio>
@@ -202,14 +203,21 @@ void findFrameTrouble(const Body& body, const std::vector<Collider>& colliders, 
     }
 
     // ---- inside: signed distance below −kInsideTolerance ----
+    // A moving mesh: when it is closed and prepared for the step ending now, by a ray's parity
+    // (MovingMeshContact::insideDepth; its continuous passes keep cloth out, but what moves cloth
+    // after them could leave it inside, unseen).
     for (size_t c = 0; c < colliders.size(); ++c) {
-        if (colliders[c].moving) continue;
+        const MovingMeshContact* moving = colliders[c].moving.get();
+        if (moving && !(moving->closed() && std::abs(moving->t1() - t) <= 1e-9 * std::max(1.0, t)))
+            continue;
         FrameTrouble in;
         in.kind = FrameTrouble::Kind::InsideCollider;
         in.limit = kInsideTolerance;
         bool heldInside = false;
         for (size_t i = 0; i < body.vertexCount(); ++i) {
-            const double depth = -queryCollider(poses[c], pos(static_cast<int>(i))).distance;
+            const double depth = moving
+                                     ? moving->insideDepth(pos(static_cast<int>(i)))
+                                     : -queryCollider(poses[c], pos(static_cast<int>(i))).distance;
             if (!(depth > kInsideTolerance)) continue;
             ++in.count;
             if (depth > in.amount) {
