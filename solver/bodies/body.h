@@ -396,6 +396,10 @@ private:
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
     // The closest point of collider k's end pose to vertex i at x, unless the vertex is known to
     // be farther than `beyond` from it (mEndBound): then false, without a query.
+    // Whether moving mesh `mesh`'s continuous test finds the path x0 → x1 of slot (collider,
+    // vertex) ending behind the face it met (deeper than ξ/4 when `deep`); cp that face's plane.
+    bool sweptBehind(const MovingMeshContact& mesh, size_t slot, const Vec3& x0, const Vec3& x1,
+                     double thick, bool deep, ContactPoint& cp);
     bool endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp);
     // Whether vertex i's step x₀ → x₁ went through collider k, ending outside (the entry in at,
     // cp).

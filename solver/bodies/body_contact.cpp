@@ -461,14 +461,10 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
         const double thick = mKin.colliders[static_cast<size_t>(ci)].thickness;
         const Vec3 v1 = vec3At(v0.data(), i) + vec3At(mDv.data(), i);
         const Vec3 x1 = vec3At(x0.data(), i) + h * v1;
-        const size_t slot = static_cast<size_t>(ci) * n + i;
-        if (mSweptClear[slot] && vec3At(mSweptAt.data(), slot) == x1) continue;
         ContactPoint cp;
-        const bool behind = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
-                            cp.distance < -kReplaneDepth * thick;
-        mSweptClear[slot] = behind ? 0 : 2;
-        vec3At(mSweptAt.data(), slot) = x1;
-        if (!behind) continue;
+        if (!sweptBehind(*c.moving, static_cast<size_t>(ci) * n + i, vec3At(x0.data(), i), x1,
+                         thick, true, cp))
+            continue;
         const double friction = mFrictionDamping[i];
         const bool inside = mFoundInside[i];
         setContact(i, ci, cp, x1, t1, thick, t1, h, x0, v0, v1, false);
@@ -512,19 +508,9 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             //   the pass put it back at the point it met, its slide over the step lost, a segment
             //   squashed to 0.93×. Made again as found inside, it is not released again.
             // A path found clear is not swept again while the rounds leave its end where it was.
-            if (!found && c.moving && (released || c.moving->openSurface())) {
-                const size_t slot = k * n + i;
-                // mSweptClear: 1 clear of any end behind a face met, 2 of one deeper than ξ/4.
-                const uint8_t clear = mSweptClear[slot];
-                if (!((released ? clear >= 1 : clear == 1) &&
-                      vec3At(mSweptAt.data(), slot) == x1)) {
-                    const double depth = released ? kReplaneDepth * thick : 0.0;
-                    found = c.moving->sweptContact(vec3At(x0.data(), i), x1, thick, cp) &&
-                            cp.distance < -depth;
-                    mSweptClear[slot] = found ? 0 : released ? 2 : 1;
-                    vec3At(mSweptAt.data(), slot) = x1;
-                }
-            }
+            if (!found && c.moving && (released || c.moving->openSurface()))
+                found = sweptBehind(*c.moving, k * n + i, vec3At(x0.data(), i), x1, thick, released,
+                                    cp);
             Vec3 at = x1;
             const ColliderPose& pose = mKin.colliders[k].end;
             if (!found) {
@@ -586,6 +572,23 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
     }
     syncFriction(v0, true);
     return changes;
+}
+
+// The moving mesh's continuous vertex test (MovingMeshContact::sweptContact) for the path x0 → x1
+// of slot (collider, vertex): true when it ends behind the face it met — by more than
+// kReplaneDepth ξ when `deep`, at all otherwise — with cp that face's plane at the step's end. An
+// end an earlier round of this substep found clear of the same depth, or of any depth for a deep
+// ask, is not tested again (mSweptClear: 1 clear of any, 2 of the deep one).
+bool Body::sweptBehind(const MovingMeshContact& mesh, size_t slot, const Vec3& x0, const Vec3& x1,
+                       double thick, bool deep, ContactPoint& cp) {
+    const uint8_t level = deep ? 2 : 1;
+    const uint8_t clear = mSweptClear[slot];
+    if (clear != 0 && clear <= level && vec3At(mSweptAt.data(), slot) == x1) return false;
+    const double depth = deep ? kReplaneDepth * thick : 0.0;
+    const bool behind = mesh.sweptContact(x0, x1, thick, cp) && cp.distance < -depth;
+    mSweptClear[slot] = behind ? 0 : level;
+    vec3At(mSweptAt.data(), slot) = x1;
+    return behind;
 }
 
 // Sliding friction in the implicit system: A_ii += c P and b_i −= c P (v₀ − v_s), P = I − nnᵀ,

@@ -397,38 +397,37 @@ MovingMeshContact::firstVertexHit(const Vec3& p0, const Vec3& p1, const std::vec
     return hit;
 }
 
-int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to,
-                                           std::vector<int>* which) const {
-    if (!mBuilt || from.size() != to.size()) return 0;
+int MovingMeshContact::endCrossings(const Vec3& a, const Vec3& b, bool first) const {
+    // The segment's box at the end pose, in the trees' frame (endQuery), whose boxes hold every
+    // triangle at the step's end.
+    contact::Box q;
+    q.add(endQuery(a));
+    q.add(endQuery(b));
     const auto& tris = mMesh->triangles();
+    int crossings = 0;
+    mBvh.queryEach(inTrees(q), [&](int k) {
+        if (first && crossings > 0) return;
+        const auto& t = tris[k];
+        if (contact::segmentCrossesTriangle(a, b, corner(true, t[0]), corner(true, t[1]),
+                                            corner(true, t[2])))
+            ++crossings;
+    });
+    return crossings;
+}
+
+int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to) const {
+    if (!mBuilt || from.size() != to.size()) return 0;
     int count = 0;
-    std::vector<int> cand;
     for (Eigen::Index i = 0; 3 * i + 2 < from.size(); ++i) {
         const Vec3 a = vec3At(from.data(), i), b = vec3At(to.data(), i);
         if (a == b || !a.allFinite() || !b.allFinite()) continue;
-        // The segment's box at the end pose, in the trees' frame (endQuery), whose boxes hold
-        // every triangle at the step's end.
-        contact::Box q;
-        q.add(endQuery(a));
-        q.add(endQuery(b));
-        cand.clear();
-        mBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
-        for (int k : cand) {
-            const auto& t = tris[k];
-            if (contact::segmentCrossesTriangle(a, b, corner(true, t[0]), corner(true, t[1]),
-                                                corner(true, t[2]))) {
-                ++count;
-                if (which) which->push_back(static_cast<int>(i));
-                break;
-            }
-        }
+        if (endCrossings(a, b, true) > 0) ++count;
     }
     return count;
 }
 
 double MovingMeshContact::insideDepth(const Vec3& x) const {
     if (!mBuilt || !mClosed || !x.allFinite()) return 0.0;
-    const auto& tris = mMesh->triangles();
     // The surface's box at the end (prepare()); a point outside it is outside.
     const contact::Box& box = mEndBox;
     if ((x.array() < box.lo.array()).any() || (x.array() > box.hi.array()).any()) return 0.0;
@@ -444,18 +443,7 @@ double MovingMeshContact::insideDepth(const Vec3& x) const {
     Vec3 dir(0.0130986, 0.0217538, 0.0174322);
     dir[axis] = sign;
     const double reach = (box.hi - box.lo).norm() + 1e-3;
-    const Vec3 end = x + reach * dir.normalized();
-    contact::Box q;
-    q.add(endQuery(x));
-    q.add(endQuery(end));
-    int crossings = 0;
-    mBvh.queryEach(inTrees(q), [&](int k) {
-        const auto& t = tris[k];
-        if (contact::segmentCrossesTriangle(x, end, corner(true, t[0]), corner(true, t[1]),
-                                            corner(true, t[2])))
-            ++crossings;
-    });
-    if (crossings % 2 == 0) return 0.0;
+    if (endCrossings(x, x + reach * dir.normalized(), false) % 2 == 0) return 0.0;
     ContactPoint cp;
     return closest(x, true, INFINITY, cp) ? std::max(cp.distance, 1e-12) : 1e-12;
 }

@@ -84,10 +84,8 @@ public:
 
     // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
     // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
-    // between the two points). `which` (optional) gets them. Vertices that did not move are not
-    // tested.
-    int movesThroughSurface(const VecX& from, const VecX& to,
-                            std::vector<int>* which = nullptr) const;
+    // between the two points). Vertices that did not move are not tested.
+    int movesThroughSurface(const VecX& from, const VecX& to) const;
 
     // The vertex test of the continuous pass for a path p0 → p1 over the prepared step, as a
     // contact plane for the solve: when the path comes within ξ/2 of the surface (a crossing
@@ -150,6 +148,9 @@ private:
     // Whether the trees' boxes, carried by the body's translation since their last refit, still
     // hold every primitive of this step within the slack limit (then mTreeOffset, mTreeSlack).
     bool treesStillHold();
+    // The faces the segment a → b crosses at the end of the prepared step (`first`: stop at
+    // the first, so 0 or 1).
+    int endCrossings(const Vec3& a, const Vec3& b, bool first) const;
     Vec3 faceNormal(bool atEnd, int tri) const;
     // The surface velocity (m/s) of triangle tri's point with weights w over a step of h s.
     Vec3 pointVelocity(int tri, const double w[3], double h) const;
