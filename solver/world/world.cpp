@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 namespace gale::solver {
 
@@ -22,6 +23,9 @@ namespace {
 // kPassStretchGrowth × what the solve left has its interval redone at half the step.
 constexpr double kPassStretch = 1.1;
 constexpr double kPassStretchGrowth = 1.05;
+// A halved interval whose pass still adds more than this fraction of what the pass added before
+// the halving is not halved again (World::advanceColliding).
+constexpr double kPassHalvingGain = 0.75;
 // A hair meets a cloth in its own solve only when it weighs at most this share of the cloth.
 constexpr double kHairMassShare = 0.05;
 } // namespace
@@ -184,6 +188,15 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
     // rest of the frame (or grows back, WorldSettings::growBack).
     int level = 0;
     int streak = 0; // passes accepted at `level` since it last changed
+    // What the pass added to the stretch (its edge's stretch over the solve's) when it last had
+    // the interval halved: a halving is worth its cost only while it cuts that. A hair pressed
+    // between a cape and the body (the cape does not feel the hair) is stretched by the pass as
+    // much at every step: three halvings there left it as stretched and made the frame cost 6×
+    // the median. A pass at a halved level that adds more than kPassHalvingGain × what the last
+    // halving's pass added is accepted (an event says so), unless it is over the limit.
+    double lastPassExcess = std::numeric_limits<double>::infinity();
+    // The vertices the pass pushed through a moving body when that last had the interval halved.
+    int lastPushedIn = std::numeric_limits<int>::max();
     // The cloth planes of the interval's solves: the last accepted pass's, and on a retry the
     // rejected pass's pairs before them.
     std::vector<std::vector<ClothContactPlane>> held = mClothPlanes;
@@ -223,7 +236,9 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
         bool stretched = false;
+        bool overLimit = false;
         double worst = 0.0;
+        double excess = 0.0;   // the most the pass added to a stretched body's stretch
         std::string worstName; // the body the pass stretched most (cloth or hair)
         for (size_t k = 0; k < n; ++k) {
             Body& body = *mBodies[mSelfBodies[k]];
@@ -232,9 +247,12 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 worst = after;
                 worstName = body.name();
             }
-            if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) ||
-                after > body.limits().overStretch)
+            const bool over = after > body.limits().overStretch;
+            if ((after > kPassStretch && after > kPassStretchGrowth * stretchBefore[k]) || over) {
                 stretched = true;
+                overLimit = overLimit || over;
+                excess = std::max(excess, after - stretchBefore[k]);
+            }
         }
         // A pass that pushed cloth through a moving body's surface (a fold pressed between the
         // cloth and a turning head: its corrections moved vertices into the body, which nothing
@@ -266,10 +284,19 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                           why.c_str(), dt / substeps / static_cast<double>(1L << level));
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         };
-        if (pushedIn > 0 && level < maxLevel) {
+        if (pushedIn > 0 && level < maxLevel && (level == 0 || pushedIn < lastPushedIn)) {
+            lastPushedIn = pushedIn;
             halve("self-collision pushed " + std::to_string(pushedIn) +
                   " cloth vertex(es) through a moving body's surface");
             continue;
+        }
+        if (pushedIn > 0 && level < maxLevel) {
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision pushed %d cloth vertex(es) through a moving "
+                          "body's surface at a step halved %d time(s), no fewer than before the "
+                          "last halving: accepted (the body's contact pushes them out next step)",
+                          tEnd, pushedIn, level);
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
         // First, the same interval again with the pairs the pass found as contact planes in
         // its solve (SelfCollision::retryPlanes): the solve then holds them and spreads what the
@@ -296,13 +323,23 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
                 continue;
             }
         }
-        if (stretched && level < maxLevel) {
+        if (stretched && level < maxLevel &&
+            (overLimit || level == 0 || excess <= kPassHalvingGain * lastPassExcess)) {
             char what[160];
             std::snprintf(what, sizeof what,
                           "self-collision stretched '%s' to %.3g × its rest length",
                           worstName.c_str(), worst);
+            lastPassExcess = excess;
             halve(what);
             continue;
+        }
+        if (stretched && level < maxLevel && !overLimit) {
+            std::snprintf(buf, sizeof buf,
+                          "t=%.6g s: self-collision stretched '%s' to %.3g × its rest length "
+                          "(+%.3g) at a step halved %d time(s), as much as before the last "
+                          "halving (+%.3g): accepted, not halved again",
+                          tEnd, worstName.c_str(), worst, excess, level, lastPassExcess);
+            for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
         if (st.unresolved > 0) {
             std::snprintf(buf, sizeof buf,
