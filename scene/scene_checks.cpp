@@ -402,10 +402,15 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         checkScale(box.extent(), c.line, c.col, what);
         double nearest = std::numeric_limits<double>::infinity();
         for (const Box& b : bodyBoxes) nearest = std::min(nearest, box.gap(b));
-        const double reach = std::max(1.0, 2.0 * clothExtent);
+        // Reach: twice the cloth's size, and as far as a body falls over the run (½ g T²: a
+        // sheet dropped from 2 m onto a ball lands on it).
+        const double run = s.frameTime(last) - s.frameTime(first);
+        const double fall = 0.5 * Vec3(s.gravity[0], s.gravity[1], s.gravity[2]).norm() * run * run;
+        const double reach = std::max(1.0, 2.0 * clothExtent) + fall;
         if (nearest > reach)
             warn(c, what + " never comes within " + metres(nearest) +
-                        " m of any cloth or hair over the run: check its position (or remove it)");
+                        " m of any cloth or hair over the run (farther than they fall in it, " +
+                        metres(fall) + " m): check its position (or remove it)");
     }
     return out;
 }

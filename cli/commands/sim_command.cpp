@@ -109,8 +109,8 @@ int runSim(const SimOptions& o) {
         // a pre-roll eases the bodies from their rest pose first.
         const int from = first - sim.runUpFrames();
         const int preroll = sim.scene().wind.settings.preroll;
-        std::cerr << "gale: frames " << from << "-" << first
-                  << " are simulated first and not written";
+        std::cerr << "gale: frames " << from << "-" << first << " are simulated first, frames "
+                  << from << "-" << first - 1 << " not written";
         if (preroll > 0)
             std::cerr << " (" << preroll << " of pre-roll, the bodies eased from their rest pose)";
         std::cerr << ": frame " << first << " starts from a simulated state\n";

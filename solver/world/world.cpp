@@ -430,9 +430,18 @@ void World::stepBody(Body& body, double t0, double dt, int substeps, long untilT
         SubstepStatus st = body.substep(env, t, h);
         if (st.retried != Trouble::None) {
             ++stats.newtonRetries;
-            std::snprintf(buf, sizeof buf,
-                          "t=%.6g s: %s (%s); substep retried with %d Newton iteration(s): %s", t,
-                          troubleName(st.retried), st.retryReason.c_str(), st.newtonIterations,
+            // (No Newton iteration: the retry's line search along the linearised step, cut
+            // st.lineSearchCuts times, already met the residual's tolerance.)
+            char how[96];
+            if (st.newtonIterations > 0)
+                std::snprintf(how, sizeof how, "with %d Newton iteration(s)", st.newtonIterations);
+            else
+                std::snprintf(how, sizeof how,
+                              "by its line search alone (the step cut %d time(s), no Newton "
+                              "iteration needed)",
+                              st.lineSearchCuts);
+            std::snprintf(buf, sizeof buf, "t=%.6g s: %s (%s); substep retried %s: %s", t,
+                          troubleName(st.retried), st.retryReason.c_str(), how,
                           st.trouble == Trouble::None ? "accepted" : "still in trouble");
             stats.events.push_back(buf);
         }

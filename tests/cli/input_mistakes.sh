@@ -104,6 +104,20 @@ scene "body/box.#.obj" > near.toml
 run "$GALE" check near.toml --set scene.frames=[1,5]
 expect_no_match "$ERR" "is bound" "a cape bound 1 cm off its body: no warning"
 
+# A collider far below the cloth: the cape (y 0.75-1.05) falls 0.41 m in 8 frames (½ g T², T =
+# 7/24 s), so a ball 1.95 m below it is out of reach and warned of; in 40 frames it falls
+# 3.7 m and lands on it: no warning.
+scene "body/box.#.obj" '[[collider]]
+name = "ball"
+type = "sphere"
+center = [0, -1.25, 0]
+radius = 0.05' > ball.toml
+run "$GALE" check ball.toml
+expect_match "$ERR" "ball.toml:10:1: warning: .*'ball' never comes within 1\.95 m of any cloth or hair over the run \(farther than they fall in it, 0\.417 m\)" \
+    "a ball out of reach is warned of ($ERR)"
+run "$GALE" check ball.toml --set 'scene.frames=[1, 40]'
+expect_no_match "$ERR" "never comes within" "a ball the cape falls onto in 40 frames: no warning"
+
 # A frame linked to a cache that is not there.
 mkdir -p linked
 for f in 1 2 3 4 5; do ln -s "$PWD/body/box.000$f.obj" "linked/box.000$f.obj"; done

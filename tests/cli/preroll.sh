@@ -123,7 +123,7 @@ box=$(python3 make.py rest)
 scene 24 'rest_mesh = "body_rest.obj"' "$box" > shot.toml
 run "$GALE" sim shot.toml -o out
 expect_rc 0 "the pre-rolled shot"
-expect_match "$ERR" "frames 977-1001 are simulated first and not written \(24 of pre-roll" \
+expect_match "$ERR" "frames 977-1001 are simulated first, frames 977-1000 not written \(24 of pre-roll" \
     "stderr says the pre-roll frames are simulated and not written"
 run check rest 1001 1024 out
 echo "check: $OUT"
