@@ -260,6 +260,41 @@ void Body::assemble(const ForceInput& in, ForceOutput& out, const Vec3& gravity,
     }
 }
 
+MovingMeshContact* Body::thinContact(size_t k, const Collider& c, double t, double h) {
+    const bool sphere = c.shape == ColliderShape::Sphere;
+    if ((!sphere && c.shape != ColliderShape::Capsule) || c.moving || !(h > 0.0)) return nullptr;
+    // Thin: its diameter with the thickness on both sides shorter than the longest rest edge, so
+    // that it fits between an edge's two vertices (a thicker one meets a vertex before a face
+    // can pass over it; and a draped edge's chord over it dips within ξ/2 of its surface, which
+    // the edge test would push out: a sheet dropped on a 3 cm capsule at 2.2 cm spacing ended
+    // 1.06× against 1.007× at 16 substeps).
+    double longest = 0.0;
+    for (double r : mEdgeRest) longest = std::max(longest, r);
+    if (!(2.0 * (c.radius + colliderThickness(c)) < longest)) return nullptr;
+    if (mThinContacts.size() <= k) mThinContacts.resize(k + 1);
+    std::shared_ptr<MovingMeshContact>& contact = mThinContacts[k];
+    const std::vector<std::array<int, 3>> tri{sphere ? std::array<int, 3>{0, 0, 0}
+                                                     : std::array<int, 3>{0, 1, 1}};
+    // Its two poses, at t and t + h: frame 0 and 1 of a two-frame sequence (frame F at
+    // t + F h).
+    std::vector<std::vector<double>> frames;
+    for (double at : {t, t + h}) {
+        const ColliderPose p = colliderPose(c, at);
+        frames.push_back({p.a[0], p.a[1], p.a[2]});
+        if (!sphere) frames.back().insert(frames.back().end(), {p.b[0], p.b[1], p.b[2]});
+    }
+    auto seq = std::make_shared<const MeshSequence>(tri, std::move(frames), 0, 1.0 / h, -t / h);
+    if (!contact) {
+        contact = std::make_shared<MovingMeshContact>(std::move(seq));
+        contact->setVertexPairs(false);
+        contact->setRadius(c.radius);
+    } else if (!(contact->t0() == t && contact->t1() == t + h)) {
+        contact->setMesh(std::move(seq));
+    }
+    contact->prepare(t, t + h);
+    return contact.get();
+}
+
 void Body::evaluateKinematics(const Environment& env, double t, double h) {
     mKin.t0 = t;
     mKin.t1 = t + h;
@@ -668,15 +703,22 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
     if (env.colliders) {
         static const std::vector<std::array<int, 3>> noTriangles;
         const std::vector<std::array<int, 3>>* tris = collisionTriangles();
-        for (const Collider& c : *env.colliders)
-            if (c.moving) {
-                std::vector<uint8_t> movable(n);
+        std::vector<uint8_t> movable;
+        for (size_t k = 0; k < env.colliders->size(); ++k) {
+            const Collider& c = (*env.colliders)[k];
+            // A sphere or capsule thinner than the edges: its centre or axis, thickened by its
+            // radius, against the edges and triangles (the vertices meet it below).
+            MovingMeshContact* thin = c.moving ? nullptr : thinContact(k, c, mKin.t0, h);
+            MovingMeshContact* mesh = c.moving ? c.moving.get() : thin;
+            if (!mesh) continue;
+            if (movable.empty()) {
+                movable.resize(n);
                 for (size_t i = 0; i < n; ++i)
                     movable[i] = mConstraints.kind[i] != 1 || mContactCollider[i] >= 0;
-                st.projected += c.moving->sweep(x0, mX, mV, movable, mEdges,
-                                                tris ? *tris : noTriangles, colliderThickness(c),
-                                                c.friction, h);
             }
+            st.projected += mesh->sweep(x0, mX, mV, movable, mEdges, tris ? *tris : noTriangles,
+                                        colliderThickness(c), c.friction, h);
+        }
     }
     st.contacts = resolveContacts(env, h, st);
 

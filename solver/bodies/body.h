@@ -401,6 +401,14 @@ private:
     bool sweptBehind(const MovingMeshContact& mesh, size_t slot, const Vec3& x0, const Vec3& x1,
                      double thick, bool deep, ContactPoint& cp);
     bool endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp);
+    // Collider k, a sphere or a capsule thinner than this body's longest edge, as a degenerate
+    // mesh moving over [t, t + h] (its centre, or its axis), for the pairs its vertex contact
+    // misses (a rod between two rows of cloth vertices); null for other colliders.
+    MovingMeshContact* thinContact(size_t k, const Collider& c, double t, double h);
+    // The resting side of a thin collider's edge contacts, at the substep's start
+    // (body_contact.cpp).
+    void thinEdgePlanes(size_t k, const Collider& c, const ColliderPose& pose, double thick,
+                        const std::vector<uint8_t>& nearSurface, double t, double h);
     // Whether vertex i's step x₀ → x₁ went through collider k, ending outside (the entry in at,
     // cp).
     bool passedThrough(size_t k, size_t i, const Vec3& xStart, const Vec3& x1, double h,
@@ -482,6 +490,8 @@ private:
     // unknown. updateContacts does not ask the continuous test again for the same end.
     std::vector<uint8_t> mSweptClear;
     VecX mSweptAt;
+    // Per collider: its degenerate mesh (thinContact), made when first needed.
+    std::vector<std::shared_ptr<MovingMeshContact>> mThinContacts;
     // Per collider and vertex: the moving mesh's triangle its last query found closest (−1
     // none), the hint of its next query (the answer does not depend on it).
     std::vector<int> mNearTriangle;

@@ -195,8 +195,14 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
         // (moving_collider.h, the body vertex–cloth triangle pair; on a 1 cm rod held 5 cm into a
         // sheet the largest stretch fell from 2.4–3.1 to 1.14–1.25 at 2 substeps). Not sticking:
         // a hand riding over examples/09's cape would drag its hem (stretch 1.30 against 1.08).
+        // (A sphere or capsule thinner than the edges, thinContact: its centre or axis ends are
+        // the body vertices, r + ξ the offset; its axis against the edges below.)
+        MovingMeshContact* thin = c.moving ? nullptr : thinContact(ci, c, t, h);
+        if (thin) thinEdgePlanes(ci, c, pose, thick, nearSurface, t, h);
+        MovingMeshContact* mesh = c.moving ? c.moving.get() : thin;
         const std::vector<std::array<int, 3>>* tris = collisionTriangles();
-        if (!c.moving || !tris) continue;
+        if (!mesh || !tris) continue;
+        const double offset = thin ? thick + c.radius : thick;
         for (const auto& tri : *tris) {
             // No corner could take a contact (each constrained already, or near the surface
             // itself): no query.
@@ -208,8 +214,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             for (int k = 0; k < 3; ++k) corners[k] = vec3At(mX.data(), tri[k]);
             Vec3 p, vel;
             double w[3], dist;
-            if (!c.moving->nearestVertex(corners[0], corners[1], corners[2], reach, p, w, dist,
-                                         vel) ||
+            if (!mesh->nearestVertex(corners[0], corners[1], corners[2],
+                                     reach + (thin ? c.radius : 0.0), p, w, dist, vel) ||
                 !(dist > 1e-12))
                 continue;
             const Vec3 q = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2];
@@ -226,7 +232,7 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
                 cp.normal = nrm;
                 cp.distance = nrm.dot(x - p);
                 cp.velocity = vel;
-                setContact(i, static_cast<int>(ci), cp, x, t, thick, t + h, h, mX, mV, v0, false);
+                setContact(i, static_cast<int>(ci), cp, x, t, offset, t + h, h, mX, mV, v0, false);
                 mContactMu[i] = c.friction;
                 mContactImpulse[i] = -un;
             }
@@ -234,6 +240,51 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
     }
     applyClothPlanes(t, h);
     if (warm) syncFriction(mV, true);
+}
+
+// A sphere's centre or a capsule's axis (collider k, thinner than the edges: thinContact) within
+// r + ξ and the contact band of an edge at the substep's start, the edge's end predicted to
+// move in: each free end not near the surface itself (its own contact holds it) gets a sliding
+// contact on the plane n·x ≥ n·x₀ − (d − r − ξ), d the distance from the axis point p closest to
+// the edge to the edge's closest point, n from p towards it, moving with p: the edge's point is
+// held r + ξ out, each end no further in than that asks — the resting side of the edge contacts
+// that updateContacts makes when a solve's edge reaches the axis (a sheet draped over a rod, held
+// from the first solve instead of after it).
+void Body::thinEdgePlanes(size_t k, const Collider& c, const ColliderPose& pose, double thick,
+                          const std::vector<uint8_t>& nearSurface, double t, double h) {
+    const Vec3 a = pose.a, b = c.shape == ColliderShape::Capsule ? pose.b : pose.a;
+    const Vec3 va = pose.velA, vb = c.shape == ColliderShape::Capsule ? pose.velB : pose.velA;
+    const double reach = c.radius + thick + kContactBand * thick + kContactSlop;
+    for (const auto& [i0, i1] : mEdges) {
+        const size_t e0 = static_cast<size_t>(i0), e1 = static_cast<size_t>(i1);
+        const bool open0 = mConstraints.kind[e0] == 0 && !nearSurface[e0],
+                   open1 = mConstraints.kind[e1] == 0 && !nearSurface[e1];
+        if (!open0 && !open1) continue;
+        const Vec3 x0 = vec3At(mX.data(), e0), x1 = vec3At(mX.data(), e1);
+        double s, u;
+        const double d2 = contact::segmentSegmentDistance2(x0, x1, a, b, s, u);
+        if (!(d2 < reach * reach) || !(d2 > 1e-24)) continue;
+        const Vec3 p = a + u * (b - a);
+        const Vec3 nrm = (x0 + s * (x1 - x0) - p) / std::sqrt(d2);
+        const Vec3 vel = va + u * (vb - va);
+        for (const size_t i : {e0, e1}) {
+            if (!(i == e0 ? open0 : open1) || mConstraints.kind[i] != 0) continue;
+            const Vec3 x = vec3At(mX.data(), i);
+            const Vec3 v0 = vec3At(mV.data(), i);
+            const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - vel;
+            const double un = pred.dot(nrm);
+            if (!(un < 0.0)) continue;
+            // The edge point's plane (as in updateContacts): its gap, not the end's own.
+            ContactPoint cp;
+            cp.normal = nrm;
+            cp.distance = std::sqrt(d2);
+            cp.velocity = vel;
+            setContact(i, static_cast<int>(k), cp, x, t, thick + c.radius, t + h, h, mX, mV, v0,
+                       false);
+            mContactMu[i] = c.friction;
+            mContactImpulse[i] = -un;
+        }
+    }
 }
 
 // Cloth against cloth in the solve (World, WorldSettings::clothContactInSolve): a free vertex
@@ -568,6 +619,51 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             mContactImpulse[i] = -(m.v1 - m.cp.velocity).dot(m.cp.normal); // the approach it had
             mFoundInside[i] = 1;
             ++st.contactAdded;
+        }
+    }
+    // Edges against a sphere's centre or a capsule's axis thinner than them (thinContact): a
+    // rod between two rows of cloth vertices, which no vertex reaches. An edge whose path in the
+    // solve comes within the collider's radius + ξ/2 of the axis (the continuous pass's edge test)
+    // gives each of its free ends a sliding contact that keeps the edge's point r + ξ out from the
+    // axis point it met, along the normal from the axis to the edge there, moving with it: the
+    // solve then holds the edge off the rod (a sheet draped over a 1 cm rod, held only by the pass
+    // after the solve, hung at 1.5× rest, its energy pumped in every step).
+    for (size_t k = 0; k < mKin.colliders.size() && !mEdges.empty(); ++k) {
+        const Collider& c = (*env.colliders)[k];
+        MovingMeshContact* thin = c.moving ? nullptr : thinContact(k, c, t, h);
+        if (!thin) continue;
+        const double thick = mKin.colliders[k].thickness;
+        const auto free = [&](int v) {
+            return mConstraints.kind[static_cast<size_t>(v)] == 0 &&
+                   !mReleased[static_cast<size_t>(v)];
+        };
+        for (const auto& [a, b] : mEdges) {
+            if (!free(a) && !free(b)) continue;
+            const Vec3 va = vec3At(v0.data(), a) + vec3At(mDv.data(), a),
+                       vb = vec3At(v0.data(), b) + vec3At(mDv.data(), b);
+            const Vec3 a0 = vec3At(x0.data(), a), b0 = vec3At(x0.data(), b);
+            EdgeHit hit;
+            if (!thin->edgeContact(a0, a0 + h * va, b0, b0 + h * vb, thick, hit)) continue;
+            // Each end's plane is the edge point's: n·x ≥ n·x₁ − g, g = n·(q₁ − p₁) − r − ξ
+            // the gap of the edge's point q₁ at the step's end (negative: short of r + ξ), so
+            // that neither end moves the point in (not n·x ≥ n·p₁ + r + ξ for each: an end on
+            // the rod's flank would be lifted level with its top).
+            ContactPoint cp;
+            cp.normal = hit.normal;
+            cp.velocity = hit.displacement / h;
+            const Vec3 q1 = a0 + h * va + hit.sa * (b0 + h * vb - a0 - h * va);
+            cp.distance = hit.normal.dot(q1 - hit.body1);
+            for (const auto& [v, v1] : {std::pair<int, Vec3>{a, va}, std::pair<int, Vec3>{b, vb}}) {
+                if (!free(v) || !((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
+                const size_t i = static_cast<size_t>(v);
+                setContact(i, static_cast<int>(k), cp, vec3At(x0.data(), i) + h * v1, t1,
+                           thick + c.radius, t1, h, x0, v0, v1, false);
+                mContactMu[i] = c.friction;
+                mContactImpulse[i] = -(v1 - cp.velocity).dot(cp.normal);
+                mFoundInside[i] = 1;
+                ++st.contactAdded;
+                ++changes;
+            }
         }
     }
     syncFriction(v0, true);

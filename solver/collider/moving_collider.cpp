@@ -463,6 +463,70 @@ bool MovingMeshContact::sweptContact(const Vec3& p0, const Vec3& p1, double thic
     return true;
 }
 
+bool MovingMeshContact::firstEdgeHit(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                                     const contact::CcdOptions& opt, double reach,
+                                     std::vector<int>& cand, EdgeHit& hit) const {
+    contact::Box q;
+    addSwept(q, a0, a1);
+    addSwept(q, b0, b1);
+    q.inflate(reach);
+    cand.clear();
+    // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges of the
+    // triangles reached whose boxes do not are farther than the CCD's ξ/2 from the cloth edge
+    // throughout the step (the query's box is inflated by `reach`), so they cannot be hit.
+    mEdgeBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
+    std::sort(cand.begin(), cand.end());
+    double first = 2.0;
+    int hitEdge = -1;
+    for (int k : cand) {
+        const int r = mEdges[k][0], s = mEdges[k][1];
+        double toi;
+        const Vec3 s0[4] = {a0, b0, corner(false, r), corner(false, s)};
+        const Vec3 s1[4] = {a1, b1, corner(true, r), corner(true, s)};
+        if (clearAtFirstAdvance(s0, s1, 2,
+                                boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0), s0[2].cwiseMin(s0[3]),
+                                       s0[2].cwiseMax(s0[3])),
+                                opt))
+            continue;
+        if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
+                                 corner(false, s), corner(true, s), opt, toi) &&
+            toi < first) {
+            first = toi;
+            hitEdge = k;
+        }
+    }
+    if (hitEdge < 0) return false;
+    const int r = mEdges[hitEdge][0], s = mEdges[hitEdge][1];
+    double sa, sb;
+    const Vec3 pa = lerp(a0, a1, first), pb = lerp(b0, b1, first);
+    const Vec3 pr = lerp(corner(false, r), corner(true, r), first),
+               ps = lerp(corner(false, s), corner(true, s), first);
+    contact::segmentSegmentDistance2(pa, pb, pr, ps, sa, sb);
+    Vec3 nt = (pa + sa * (pb - pa)) - (pr + sb * (ps - pr));
+    if (!(nt.norm() > 1e-12)) nt = (pb - pa).cross(ps - pr);
+    if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
+    hit.edge = hitEdge;
+    hit.toi = first;
+    hit.sa = sa;
+    hit.sb = sb;
+    hit.normal = nt.normalized();
+    // At the end: the body point at the same parameter, and its move over the step.
+    const Vec3 r1 = corner(true, r), s1 = corner(true, s);
+    hit.body1 = r1 + sb * (s1 - r1);
+    hit.displacement = (1.0 - sb) * (r1 - corner(false, r)) + sb * (s1 - corner(false, s));
+    return true;
+}
+
+bool MovingMeshContact::edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                                    double thickness, EdgeHit& hit) const {
+    if (!mBuilt || !a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite())
+        return false;
+    contact::CcdOptions opt = sweepOptions(thickness);
+    opt.thickness += mRadius;
+    std::vector<int> cand;
+    return firstEdgeHit(a0, a1, b0, b1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
+}
+
 int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
                              const std::vector<std::array<int, 2>>& edges,
@@ -488,8 +552,14 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // (shrinkWithinThickness), the push-out restores ξ, so a vertex that leaves is not held back.
     // For a primitive held off the body by ξ: the CCD's options, and the distance a hit is
     // placed at (ξ and ξ/2 as above; ξ_e below for pinned vertices within the thickness).
-    const auto placedAt = [](double xi) { return xi * (1.0 + 1e-6) + 1e-9; };
-    const contact::CcdOptions opt = sweepOptions(thickness);
+    // (A thin collider's centre or axis, setRadius: ξ measured from its surface, r out.)
+    const auto placedAt = [&](double xi) { return xi * (1.0 + 1e-6) + 1e-9 + mRadius; };
+    const auto ccdFor = [&](double xi) {
+        contact::CcdOptions o = sweepOptions(xi);
+        o.thickness += mRadius;
+        return o;
+    };
+    const contact::CcdOptions opt = ccdFor(thickness);
     // The broad phase's reach: the CCD asks for at most ξ/2 (less for pinned corners), and the
     // swept boxes hold each primitive throughout the step (its points are convex combinations
     // of its corners at both ends), so a pair whose boxes are farther apart than ξ/2 stays
@@ -529,8 +599,9 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
         if (c < 0.0) {
             c = thickness;
             ContactPoint cp;
-            if (closest(vec3At(x0.data(), v), false, thickness, cp)) c = std::min(c, cp.distance);
-            if (closest(vec3At(x1.data(), v), true, thickness, cp)) c = std::min(c, cp.distance);
+            const double r = thickness + mRadius;
+            if (closest(vec3At(x0.data(), v), false, r, cp)) c = std::min(c, cp.distance - mRadius);
+            if (closest(vec3At(x1.data(), v), true, r, cp)) c = std::min(c, cp.distance - mRadius);
             c = std::max(c, 1e-3 * thickness); // on the surface: only crossing is caught
         }
         return c;
@@ -538,7 +609,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     for (int pass = 0; pass < passes; ++pass) {
         int hits = 0;
         // Vertices against triangles.
-        for (size_t i = 0; i < n; ++i) {
+        for (size_t i = 0; i < n && mVertexPairs; ++i) {
             if (!movable[i]) continue;
             const Vec3 p0 = vec3At(x0.data(), i), p1 = vec3At(x1.data(), i);
             if (!p0.allFinite() || !p1.allFinite()) continue; // left to the trouble detector
@@ -578,59 +649,20 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const int i = e[0], j = e[1];
             if (!movable[i] && !movable[j]) continue;
             const double xiE = std::min(clearanceOf(i), clearanceOf(j));
-            const contact::CcdOptions optE = sweepOptions(xiE);
+            const contact::CcdOptions optE = ccdFor(xiE);
             const double wantE = placedAt(xiE);
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
             if (!a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite()) continue;
             auto tb = tick();
-            contact::Box q;
-            addSwept(q, a0, a1);
-            addSwept(q, b0, b1);
-            q.inflate(reach);
-            cand.clear();
-            // The edges whose own swept boxes reach the cloth edge's, in edge order. The edges
-            // of the triangles reached whose boxes do not are farther than the CCD's ξ/2 from
-            // the cloth edge throughout the step (the query's box is inflated by `reach`), so
-            // they cannot be hit.
-            mEdgeBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
-            std::sort(cand.begin(), cand.end());
+            EdgeHit hit;
+            const bool found = firstEdgeHit(a0, a1, b0, b1, optE, reach, cand, hit);
             mStats.broadSeconds += since(tb);
             mStats.candidates += static_cast<long long>(cand.size());
             auto tn = tick();
-            double first = 2.0;
-            int hitEdge = -1;
-            for (int k : cand) {
-                const int r = mEdges[k][0], s = mEdges[k][1];
-                double toi;
-                const Vec3 s0[4] = {a0, b0, corner(false, r), corner(false, s)};
-                const Vec3 s1[4] = {a1, b1, corner(true, r), corner(true, s)};
-                if (clearAtFirstAdvance(s0, s1, 2,
-                                        boxGap(a0.cwiseMin(b0), a0.cwiseMax(b0),
-                                               s0[2].cwiseMin(s0[3]), s0[2].cwiseMax(s0[3])),
-                                        optE))
-                    continue;
-                if (contact::edgeEdgeCcd(a0, a1, b0, b1, corner(false, r), corner(true, r),
-                                         corner(false, s), corner(true, s), optE, toi) &&
-                    toi < first) {
-                    first = toi;
-                    hitEdge = k;
-                }
-            }
-            if (hitEdge >= 0) {
-                const int r = mEdges[hitEdge][0], s = mEdges[hitEdge][1];
-                double sa, sb;
-                const Vec3 pa = lerp(a0, a1, first), pb = lerp(b0, b1, first);
-                const Vec3 pr = lerp(corner(false, r), corner(true, r), first),
-                           ps = lerp(corner(false, s), corner(true, s), first);
-                contact::segmentSegmentDistance2(pa, pb, pr, ps, sa, sb);
-                Vec3 nt = (pa + sa * (pb - pa)) - (pr + sb * (ps - pr));
-                if (!(nt.norm() > 1e-12)) nt = (pb - pa).cross(ps - pr);
-                if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
-                const Vec3 nn = nt.normalized();
-                // At the end: the body point and the cloth point at the same parameters.
-                const Vec3 r1 = corner(true, r), s1 = corner(true, s);
-                const Vec3 body1 = r1 + sb * (s1 - r1);
+            if (found) {
+                const double sa = hit.sa;
+                const Vec3 nn = hit.normal, body1 = hit.body1;
                 Eigen::Map<Vec3> xa(x1.data() + 3 * i), xb(x1.data() + 3 * j);
                 const Vec3 cloth1 = xa + sa * (xb - xa);
                 const double gap = (cloth1 - body1).dot(nn);
@@ -650,9 +682,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                         xb += wb * d;
                     }
                 }
-                Vec3 vs = Vec3::Zero();
-                if (h > 0.0)
-                    vs = ((1.0 - sb) * (r1 - corner(false, r)) + sb * (s1 - corner(false, s))) / h;
+                const Vec3 vs = h > 0.0 ? Vec3(hit.displacement / h) : Vec3::Zero();
                 if (movable[i]) respond(i, vs, nn);
                 if (movable[j]) respond(j, vs, nn);
                 ++hits;
@@ -676,7 +706,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!finite) continue; // left to the trouble detector
             const double xiT =
                 std::min({clearanceOf(tv[0]), clearanceOf(tv[1]), clearanceOf(tv[2])});
-            const contact::CcdOptions optT = sweepOptions(xiT);
+            const contact::CcdOptions optT = ccdFor(xiT);
             const double wantT = placedAt(xiT);
             auto tb = tick();
             contact::Box q;

@@ -36,6 +36,16 @@ struct MovingContactStats {
               edgeHits = 0, faceHits = 0, unresolved = 0;
 };
 
+// The first body edge a moving cloth edge meets in the continuous pass: its index, the
+// fraction of the step, the two edges' closest points' parameters then (sa on the cloth edge,
+// sb on the body's), the unit normal from the body towards the cloth there, the body point at
+// the step's end and its move over the step (m).
+struct EdgeHit {
+    int edge = -1;
+    double toi = 2.0, sa = 0.0, sb = 0.0;
+    Vec3 normal = Vec3::UnitY(), body1 = Vec3::Zero(), displacement = Vec3::Zero();
+};
+
 class MovingMeshContact {
 public:
     explicit MovingMeshContact(std::shared_ptr<const MeshSequence> mesh);
@@ -82,6 +92,12 @@ public:
               const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
               double h, int passes = 4);
 
+    // The edge test of the continuous pass alone, for the solve's contacts (Body): the cloth edge
+    // a0b0 → a1b1 against the body's edges, kept `thickness` off (from the surface r out of a
+    // thin collider's axis, setRadius). False when it meets none.
+    bool edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                     double thickness, EdgeHit& hit) const;
+
     // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
     // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
     // between the two points). Vertices that did not move are not tested.
@@ -108,6 +124,14 @@ public:
     // Coulomb's bound (a body's hit holds the vertex at the point it met).
     void setOpenSurface(bool open) { mOpen = open; }
     bool openSurface() const { return mOpen; }
+    // Whether sweep() tests the body's vertices' paths against the surface (on: a mesh). Off for
+    // a sphere's centre or a capsule's axis as a degenerate mesh (Body::thinContact), whose
+    // vertex contact the analytic collider already gives: sweep() then adds only the pairs it
+    // misses, cloth edges against the axis and cloth triangles against its ends.
+    void setVertexPairs(bool on) { mVertexPairs = on; }
+    // The radius (m) of such a centre or axis: sweep() keeps primitives its thickness off the
+    // surface r out from it.
+    void setRadius(double r) { mRadius = r; }
 
     const MovingContactStats& stats() const { return mStats; }
     // Clock the broad and narrow phase of every primitive (MovingContactStats; benchmarks).
@@ -115,6 +139,10 @@ public:
 
 private:
     Vec3 corner(bool atEnd, int v) const;
+    // The edge test for CCD options `opt`, candidates from the tree within `reach` (into cand).
+    bool firstEdgeHit(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                      const contact::CcdOptions& opt, double reach, std::vector<int>& cand,
+                      EdgeHit& hit) const;
     // A point's box over the step in the step's moving frame: p0 at the start, p1 at the end
     // (world positions).
     void addSwept(contact::Box& b, const Vec3& p0, const Vec3& p1) const {
@@ -172,6 +200,8 @@ private:
 
     std::shared_ptr<const MeshSequence> mMesh;
     bool mOpen = false;                     // setOpenSurface
+    bool mVertexPairs = true;               // setVertexPairs
+    double mRadius = 0.0;                   // setRadius (m)
     std::vector<std::array<int, 2>> mEdges; // unique body edges
     bool mClosed = false;                   // every edge in exactly two triangles
     contact::Box mEndBox;                   // the corners at t1 (prepare; insideDepth)
