@@ -15,6 +15,7 @@
 #   held by the pass after the solve alone, it hung at 1.5-1.7× rest with 4-8 J of elastic
 #   energy (the solve pulled it through the rod every step).
 # - A 1 cm ball shot at 2 m/s at the centre of a face: the sheet is pushed ahead of it.
+# - The rod swept through hanging hair between two strand vertices: every strand is carried.
 source "$(dirname "$0")/lib.bash" "$@"
 PY=$(test -x /usr/bin/python3 && echo /usr/bin/python3 || echo python3)
 "$PY" -c 'import numpy' 2> /dev/null || { echo "SKIP: python3 with numpy is not installed (make deps installs python3-numpy)"; exit 0; }
@@ -155,4 +156,53 @@ expect_rc 0 "the ball through a face"
 # (Its centre against the face is met after the solve only: the pass pushes the face's corners,
 # 1.21× at the impact; in the solve only edges meet an axis.)
 STRETCH_LIMIT=1.3 check "the ball (frames 3-24)" ball faces 3 24 $cx,$cy,0.08 $cx,$cy,0.08 2 1
+
+# Hair: ten strands of 3 cm segments hanging from y = 0, the same rod swept between two of
+# their vertices (y = -0.315): each strand, where it crosses the rod's height at the last frame,
+# is ahead of the rod (z > 0.08). Before, every strand stayed at z = 0 (the rod passed through).
+"$PY" - <<'PY'
+with open("hair.csv", "w") as f:
+    f.write("x,y,z,strand\n")
+    for s in range(10):
+        for k in range(21):
+            f.write("%f,%f,0,%d\n" % (-0.097 + 0.02 * s, -0.03 * k, s))
+PY
+cat > hair.toml <<'TOML'
+[scene]
+fps = 24
+frames = [1, 24]
+substeps = 1
+
+[[hair]]
+name = "h"
+strands = "hair.csv"
+radius = 5e-5
+density = 1300.0
+stretch = 20.0
+bend = 2e-6
+
+[[collider]]
+name = "rod"
+type = "capsule"
+a = { keys = [[0, [-0.4, -0.315, -0.1]], [0.09, [-0.4, -0.315, 0.08]]], interp = "linear" }
+b = { keys = [[0, [0.4, -0.315, -0.1]], [0.09, [0.4, -0.315, 0.08]]], interp = "linear" }
+radius = 0.005
+thickness = 0.003
+TOML
+run "$GALE" sim hair.toml -o hair
+expect_rc 0 "the rod through hair"
+ahead=$("$PY" - <<'PY'
+import glob
+V = [list(map(float, l.split()[1:4])) for l in open(sorted(glob.glob("hair/h.*.obj"))[-1]) if l.startswith("v ")]
+n = 0
+for s in range(10):
+    P = V[21 * s:21 * s + 21]
+    for k in range(20):
+        y0, y1 = P[k][1] + 0.315, P[k + 1][1] + 0.315
+        if y0 * y1 < 0 and P[k][2] + y0 / (y0 - y1) * (P[k + 1][2] - P[k][2]) > 0.08:
+            n += 1
+print(n)
+PY
+)
+expect_eq "$ahead" "10" "strands ahead of the rod at the last frame"
 finish
