@@ -409,6 +409,8 @@ private:
     // (body_contact.cpp).
     void thinEdgePlanes(size_t k, const Collider& c, const ColliderPose& pose, double thick,
                         const std::vector<uint8_t>& nearSurface, double t, double h);
+    void planeContact(size_t i, int ci, const Vec3& normal, double distance, const Vec3& velocity,
+                      double offset, double mu, double t, double h);
     // Whether vertex i's step x₀ → x₁ went through collider k, ending outside (the entry in at,
     // cp).
     bool passedThrough(size_t k, size_t i, const Vec3& xStart, const Vec3& x1, double h,

@@ -223,18 +223,8 @@ void Body::contactConstraints(const Environment& env, double t, double h) {
             for (int k = 0; k < 3; ++k) {
                 const int i = tri[k];
                 if (!(w[k] > 0.05) || mConstraints.kind[i] != 0 || nearSurface[i]) continue;
-                const Vec3 x = corners[k];
-                const Vec3 v0 = vec3At(mV.data(), i);
-                const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - vel;
-                const double un = pred.dot(nrm);
-                if (!(un < 0.0)) continue;
-                ContactPoint cp;
-                cp.normal = nrm;
-                cp.distance = nrm.dot(x - p);
-                cp.velocity = vel;
-                setContact(i, static_cast<int>(ci), cp, x, t, offset, t + h, h, mX, mV, v0, false);
-                mContactMu[i] = c.friction;
-                mContactImpulse[i] = -un;
+                planeContact(static_cast<size_t>(i), static_cast<int>(ci), nrm,
+                             nrm.dot(corners[k] - p), vel, offset, c.friction, t, h);
             }
         }
     }
@@ -267,24 +257,30 @@ void Body::thinEdgePlanes(size_t k, const Collider& c, const ColliderPose& pose,
         const Vec3 p = a + u * (b - a);
         const Vec3 nrm = (x0 + s * (x1 - x0) - p) / std::sqrt(d2);
         const Vec3 vel = va + u * (vb - va);
-        for (const size_t i : {e0, e1}) {
-            if (!(i == e0 ? open0 : open1) || mConstraints.kind[i] != 0) continue;
-            const Vec3 x = vec3At(mX.data(), i);
-            const Vec3 v0 = vec3At(mV.data(), i);
-            const Vec3 pred = v0 + (h / mMass[i]) * vec3At(mF.data(), i) - vel;
-            const double un = pred.dot(nrm);
-            if (!(un < 0.0)) continue;
-            // The edge point's plane (as in updateContacts): its gap, not the end's own.
-            ContactPoint cp;
-            cp.normal = nrm;
-            cp.distance = std::sqrt(d2);
-            cp.velocity = vel;
-            setContact(i, static_cast<int>(k), cp, x, t, thick + c.radius, t + h, h, mX, mV, v0,
-                       false);
-            mContactMu[i] = c.friction;
-            mContactImpulse[i] = -un;
-        }
+        // The edge point's plane (as in updateContacts): its gap, not the end's own.
+        for (const size_t i : {e0, e1})
+            if ((i == e0 ? open0 : open1) && mConstraints.kind[i] == 0)
+                planeContact(i, static_cast<int>(k), nrm, std::sqrt(d2), vel, thick + c.radius,
+                             c.friction, t, h);
     }
+}
+
+// A sliding contact for free vertex i at the substep's start on the plane `distance` below it
+// along `normal`, offset out by `offset` (n·x₁ ≥ n·x − distance + offset), moving at `velocity`,
+// when its predicted motion (no constraint) moves it in relative to the plane.
+void Body::planeContact(size_t i, int ci, const Vec3& normal, double distance,
+                        const Vec3& velocity, double offset, double mu, double t, double h) {
+    const Vec3 x = vec3At(mX.data(), i);
+    const Vec3 v0 = vec3At(mV.data(), i);
+    const double un = (v0 + (h / mMass[i]) * vec3At(mF.data(), i) - velocity).dot(normal);
+    if (!(un < 0.0)) return;
+    ContactPoint cp;
+    cp.normal = normal;
+    cp.distance = distance;
+    cp.velocity = velocity;
+    setContact(i, ci, cp, x, t, offset, t + h, h, mX, mV, v0, false);
+    mContactMu[i] = mu;
+    mContactImpulse[i] = -un;
 }
 
 // Cloth against cloth in the solve (World, WorldSettings::clothContactInSolve): a free vertex
