@@ -527,6 +527,79 @@ bool MovingMeshContact::edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& 
     return firstEdgeHit(a0, a1, b0, b1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
 }
 
+bool MovingMeshContact::firstFaceHit(const Vec3 c0[3], const Vec3 c1[3],
+                                     const contact::CcdOptions& opt, double reach,
+                                     std::vector<int>& cand, FaceHit& hit) const {
+    contact::Box q;
+    for (int k = 0; k < 3; ++k) addSwept(q, c0[k], c1[k]);
+    q.inflate(reach);
+    cand.clear();
+    mVertexBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
+    std::sort(cand.begin(), cand.end()); // body vertex order: a fixed tie-break
+    const Vec3 lo = c0[0].cwiseMin(c0[1]).cwiseMin(c0[2]),
+               hi = c0[0].cwiseMax(c0[1]).cwiseMax(c0[2]);
+    double first = 2.0;
+    int hitVertex = -1;
+    for (int k : cand) {
+        const int b = mVertices[k];
+        const Vec3 p0 = corner(false, b), p1 = corner(true, b);
+        const Vec3 s0[4] = {p0, c0[0], c0[1], c0[2]};
+        const Vec3 s1[4] = {p1, c1[0], c1[1], c1[2]};
+        if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), opt)) continue;
+        double toi;
+        if (contact::vertexTriangleCcd(p0, p1, c0[0], c1[0], c0[1], c1[1], c0[2], c1[2], opt,
+                                       toi) &&
+            toi < first) {
+            first = toi;
+            hitVertex = b;
+        }
+    }
+    if (hitVertex < 0) return false;
+    const Vec3 p0 = corner(false, hitVertex), p1 = corner(true, hitVertex);
+    const Vec3 pt = lerp(p0, p1, first);
+    const Vec3 a = lerp(c0[0], c1[0], first), b = lerp(c0[1], c1[1], first),
+               c = lerp(c0[2], c1[2], first);
+    double* w = hit.w;
+    contact::pointTriangleDistance2(pt, a, b, c, w);
+    const Vec3 qt = w[0] * a + w[1] * b + w[2] * c;
+    // From the cloth towards the body vertex, at τ; touching: the face normal on the side the
+    // vertex started.
+    Vec3 nt = pt - qt;
+    if (!(nt.norm() > 1e-12)) {
+        const Vec3 fnt = (b - a).cross(c - a);
+        const Vec3 qs = w[0] * c0[0] + w[1] * c0[1] + w[2] * c0[2];
+        nt = fnt.dot(p0 - qs) >= 0.0 ? fnt : Vec3(-fnt);
+    }
+    if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
+    nt.normalize();
+    // The side carried to the end of the step with the face; off its interior the direction to
+    // the feature met (the face normal does not separate there).
+    Vec3 n1 = nt;
+    const Vec3 fn1 = (c1[1] - c1[0]).cross(c1[2] - c1[0]);
+    const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
+    if (interior && fn1.norm() > 1e-12) {
+        n1 = fn1.normalized();
+        if (n1.dot(nt) < 0.0) n1 = -n1;
+    }
+    hit.vertex = hitVertex;
+    hit.toi = first;
+    hit.p0 = p0;
+    hit.p1 = p1;
+    hit.normal = n1;
+    return true;
+}
+
+bool MovingMeshContact::faceContact(const Vec3 c0[3], const Vec3 c1[3], double thickness,
+                                    FaceHit& hit) const {
+    for (int k = 0; k < 3; ++k)
+        if (!c0[k].allFinite() || !c1[k].allFinite()) return false;
+    if (!mBuilt) return false;
+    contact::CcdOptions opt = sweepOptions(thickness);
+    opt.thickness += mRadius;
+    std::vector<int> cand;
+    return firstFaceHit(c0, c1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
+}
+
 int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
                              const std::vector<std::array<int, 2>>& edges,
@@ -709,62 +782,16 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const contact::CcdOptions optT = ccdFor(xiT);
             const double wantT = placedAt(xiT);
             auto tb = tick();
-            contact::Box q;
-            for (int k = 0; k < 3; ++k) addSwept(q, c0[k], c1[k]);
-            q.inflate(reach);
-            cand.clear();
-            mVertexBvh.queryEach(inTrees(q), [&](int k) { cand.push_back(k); });
-            std::sort(cand.begin(), cand.end()); // body vertex order: a fixed tie-break
+            FaceHit hit;
+            const bool found = firstFaceHit(c0, c1, optT, reach, cand, hit);
             const double broad = since(tb);
             mStats.broadSeconds += broad;
             mStats.candidates += static_cast<long long>(cand.size());
             mStats.faceCandidates += static_cast<long long>(cand.size());
             auto tn = tick();
-            const Vec3 lo = c0[0].cwiseMin(c0[1]).cwiseMin(c0[2]),
-                       hi = c0[0].cwiseMax(c0[1]).cwiseMax(c0[2]);
-            double first = 2.0;
-            int hitVertex = -1;
-            for (int k : cand) {
-                const int b = mVertices[k];
-                const Vec3 p0 = corner(false, b), p1 = corner(true, b);
-                const Vec3 s0[4] = {p0, c0[0], c0[1], c0[2]};
-                const Vec3 s1[4] = {p1, c1[0], c1[1], c1[2]};
-                if (clearAtFirstAdvance(s0, s1, 1, boxGap(p0, p0, lo, hi), optT)) continue;
-                double toi;
-                if (contact::vertexTriangleCcd(p0, p1, c0[0], c1[0], c0[1], c1[1], c0[2], c1[2],
-                                               optT, toi) &&
-                    toi < first) {
-                    first = toi;
-                    hitVertex = b;
-                }
-            }
-            if (hitVertex >= 0) {
-                const Vec3 p0 = corner(false, hitVertex), p1 = corner(true, hitVertex);
-                const Vec3 pt = lerp(p0, p1, first);
-                const Vec3 a = lerp(c0[0], c1[0], first), b = lerp(c0[1], c1[1], first),
-                           c = lerp(c0[2], c1[2], first);
-                double w[3];
-                contact::pointTriangleDistance2(pt, a, b, c, w);
-                const Vec3 qt = w[0] * a + w[1] * b + w[2] * c;
-                // From the cloth towards the body vertex, at τ; touching: the face normal on the
-                // side the vertex started.
-                Vec3 nt = pt - qt;
-                if (!(nt.norm() > 1e-12)) {
-                    const Vec3 fnt = (b - a).cross(c - a);
-                    const Vec3 qs = w[0] * c0[0] + w[1] * c0[1] + w[2] * c0[2];
-                    nt = fnt.dot(p0 - qs) >= 0.0 ? fnt : Vec3(-fnt);
-                }
-                if (!(nt.norm() > 1e-12)) nt = Vec3::UnitY();
-                nt.normalize();
-                // The side carried to the end of the step with the face; off its interior the
-                // direction to the feature met (the face normal does not separate there).
-                Vec3 n1 = nt;
-                const Vec3 fn1 = (c1[1] - c1[0]).cross(c1[2] - c1[0]);
-                const bool interior = w[0] > 1e-9 && w[1] > 1e-9 && w[2] > 1e-9;
-                if (interior && fn1.norm() > 1e-12) {
-                    n1 = fn1.normalized();
-                    if (n1.dot(nt) < 0.0) n1 = -n1;
-                }
+            if (found) {
+                const Vec3 p0 = hit.p0, p1 = hit.p1, n1 = hit.normal;
+                const double* w = hit.w;
                 double wm[3], norm = 0.0;
                 for (int k = 0; k < 3; ++k) {
                     wm[k] = movable[tv[k]] ? w[k] : 0.0;

@@ -46,6 +46,17 @@ struct EdgeHit {
     Vec3 normal = Vec3::UnitY(), body1 = Vec3::Zero(), displacement = Vec3::Zero();
 };
 
+// The first body vertex a moving cloth triangle meets in the continuous pass: its index, the
+// fraction of the step, the vertex at the step's two ends, the weights of the triangle's point it
+// met, and the unit normal from the cloth towards it (the face's at the step's end, on the side
+// the vertex came from, when the point is inside the face).
+struct FaceHit {
+    int vertex = -1;
+    double toi = 2.0;
+    double w[3] = {0.0, 0.0, 0.0};
+    Vec3 p0 = Vec3::Zero(), p1 = Vec3::Zero(), normal = Vec3::UnitY();
+};
+
 class MovingMeshContact {
 public:
     explicit MovingMeshContact(std::shared_ptr<const MeshSequence> mesh);
@@ -98,6 +109,10 @@ public:
     bool edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
                      double thickness, EdgeHit& hit) const;
 
+    // The body vertex–cloth triangle test of the continuous pass alone (as edgeContact): the
+    // triangle with corners c0 → c1 against the body's vertices.
+    bool faceContact(const Vec3 c0[3], const Vec3 c1[3], double thickness, FaceHit& hit) const;
+
     // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
     // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
     // between the two points). Vertices that did not move are not tested.
@@ -139,6 +154,9 @@ public:
 
 private:
     Vec3 corner(bool atEnd, int v) const;
+    // The face test for CCD options `opt`, candidates from the tree within `reach` (into cand).
+    bool firstFaceHit(const Vec3 c0[3], const Vec3 c1[3], const contact::CcdOptions& opt,
+                      double reach, std::vector<int>& cand, FaceHit& hit) const;
     // The edge test for CCD options `opt`, candidates from the tree within `reach` (into cand).
     bool firstEdgeHit(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
                       const contact::CcdOptions& opt, double reach, std::vector<int>& cand,

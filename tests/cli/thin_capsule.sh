@@ -153,9 +153,10 @@ type = \"sphere\"
 center = { keys = [[0, [$cx, $cy, -0.1]], [0.09, [$cx, $cy, 0.08]]], interp = \"linear\" }" > ball.toml
 run "$GALE" sim ball.toml -o ball
 expect_rc 0 "the ball through a face"
-# (Its centre against the face is met after the solve only: the pass pushes the face's corners,
-# 1.21× at the impact; in the solve only edges meet an axis.)
-STRETCH_LIMIT=1.3 check "the ball (frames 3-24)" ball faces 3 24 $cx,$cy,0.08 $cx,$cy,0.08 2 1
+# (Its centre meets the face in no edge's reach: in the solve's rounds the face's corners are
+# held so that its point keeps r + ξ, 1.16× at the impact at one substep a frame, 1.03× at
+# sixteen; the pass after the solve alone left 1.21×.)
+STRETCH_LIMIT=1.25 check "the ball (frames 3-24)" ball faces 3 24 $cx,$cy,0.08 $cx,$cy,0.08 2 1
 
 # Hair: ten strands of 3 cm segments hanging from y = 0, the same rod swept between two of
 # their vertices (y = -0.315): each strand, where it crosses the rod's height at the last frame,
