@@ -394,12 +394,12 @@ private:
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);
     int resolveContacts(const Environment& env, double h, SubstepStatus& st);
-    // The closest point of collider k's end pose to vertex i at x, unless the vertex is known to
-    // be farther than `beyond` from it (mEndBound): then false, without a query.
     // Whether moving mesh `mesh`'s continuous test finds the path x0 → x1 of slot (collider,
     // vertex) ending behind the face it met (deeper than ξ/4 when `deep`); cp that face's plane.
     bool sweptBehind(const MovingMeshContact& mesh, size_t slot, const Vec3& x0, const Vec3& x1,
                      double thick, bool deep, ContactPoint& cp);
+    // The closest point of collider k's end pose to vertex i at x, unless the vertex is known to
+    // be farther than `beyond` from it (mEndBound): then false, without a query.
     bool endPoseQuery(size_t k, size_t i, const Vec3& x, double beyond, ContactPoint& cp);
     // Collider k, a sphere or a capsule thinner than this body's longest edge, as a degenerate
     // mesh moving over [t, t + h] (its centre, or its axis), for the pairs its vertex contact
@@ -409,6 +409,7 @@ private:
     // (body_contact.cpp).
     void thinEdgePlanes(size_t k, const Collider& c, const ColliderPose& pose, double thick,
                         const std::vector<uint8_t>& nearSurface, double t, double h);
+    // A sliding contact for free vertex i at the substep's start on a plane (body_contact.cpp).
     void planeContact(size_t i, int ci, const Vec3& normal, double distance, const Vec3& velocity,
                       double offset, double mu, double t, double h);
     // Whether vertex i's step x₀ → x₁ went through collider k, ending outside (the entry in at,
@@ -461,6 +462,7 @@ private:
     std::vector<uint8_t> mHeld; // vertices in no element: held in place
     std::vector<std::array<int, 2>> mEdges;
     std::vector<double> mEdgeRest;
+    double mLongestRest = 0.0; // the longest of mEdgeRest (m)
     std::vector<double> mDeferDepth; // updateContacts: per vertex, its depth past the surface
     BlockMatrix mA;
     FilteredSolver mSolver;
@@ -492,8 +494,10 @@ private:
     // unknown. updateContacts does not ask the continuous test again for the same end.
     std::vector<uint8_t> mSweptClear;
     VecX mSweptAt;
-    // Per collider: its degenerate mesh (thinContact), made when first needed.
+    // Per collider: its degenerate mesh (thinContact), made when first needed; the candidates of
+    // its edge and face tests in the solve's rounds (scratch).
     std::vector<std::shared_ptr<MovingMeshContact>> mThinContacts;
+    std::vector<int> mThinCandidates;
     // Per collider and vertex: the moving mesh's triangle its last query found closest (−1
     // none), the hint of its next query (the answer does not depend on it).
     std::vector<int> mNearTriangle;

@@ -633,13 +633,28 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             return mConstraints.kind[static_cast<size_t>(v)] == 0 &&
                    !mReleased[static_cast<size_t>(v)];
         };
+        // Free vertex v, ending the solve at x1 with v1, held on the plane of cp (the edge's or
+        // face's point's gap, r + ξ out) if it moves in relative to it: found inside, so that the
+        // rounds end.
+        const auto hold = [&](int v, const ContactPoint& cp, const Vec3& x1, const Vec3& v1) {
+            if (!free(v) || !((v1 - cp.velocity).dot(cp.normal) < 0.0)) return;
+            const size_t i = static_cast<size_t>(v);
+            setContact(i, static_cast<int>(k), cp, x1, t1, thick + c.radius, t1, h, x0, v0, v1,
+                       false);
+            mContactMu[i] = c.friction;
+            mContactImpulse[i] = -(v1 - cp.velocity).dot(cp.normal);
+            mFoundInside[i] = 1;
+            ++st.contactAdded;
+            ++changes;
+        };
         for (const auto& [a, b] : mEdges) {
             if (!free(a) && !free(b)) continue;
             const Vec3 va = vec3At(v0.data(), a) + vec3At(mDv.data(), a),
                        vb = vec3At(v0.data(), b) + vec3At(mDv.data(), b);
             const Vec3 a0 = vec3At(x0.data(), a), b0 = vec3At(x0.data(), b);
             EdgeHit hit;
-            if (!thin->edgeContact(a0, a0 + h * va, b0, b0 + h * vb, thick, hit)) continue;
+            if (!thin->edgeContact(a0, a0 + h * va, b0, b0 + h * vb, thick, mThinCandidates, hit))
+                continue;
             // Each end's plane is the edge point's: n·x ≥ n·x₁ − g, g = n·(q₁ − p₁) − r − ξ
             // the gap of the edge's point q₁ at the step's end (negative: short of r + ξ), so
             // that neither end moves the point in (not n·x ≥ n·p₁ + r + ξ for each: an end on
@@ -649,17 +664,8 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
             cp.velocity = hit.displacement / h;
             const Vec3 q1 = a0 + h * va + hit.sa * (b0 + h * vb - a0 - h * va);
             cp.distance = hit.normal.dot(q1 - hit.body1);
-            for (const auto& [v, v1] : {std::pair<int, Vec3>{a, va}, std::pair<int, Vec3>{b, vb}}) {
-                if (!free(v) || !((v1 - cp.velocity).dot(cp.normal) < 0.0)) continue;
-                const size_t i = static_cast<size_t>(v);
-                setContact(i, static_cast<int>(k), cp, vec3At(x0.data(), i) + h * v1, t1,
-                           thick + c.radius, t1, h, x0, v0, v1, false);
-                mContactMu[i] = c.friction;
-                mContactImpulse[i] = -(v1 - cp.velocity).dot(cp.normal);
-                mFoundInside[i] = 1;
-                ++st.contactAdded;
-                ++changes;
-            }
+            hold(a, cp, a0 + h * va, va);
+            hold(b, cp, b0 + h * vb, vb);
         }
         // Its centre or tips against the triangles the same way (a 1 cm ball shot at a face's
         // centre, where it enters no edge's reach: 1.21× at the impact when the pass after the
@@ -676,25 +682,14 @@ int Body::updateContacts(const Environment& env, double t, double h, const VecX&
                 c1[j] = c0[j] + h * v1[j];
             }
             FaceHit hit;
-            if (!thin->faceContact(c0, c1, thick, hit)) continue;
+            if (!thin->faceContact(c0, c1, thick, mThinCandidates, hit)) continue;
             ContactPoint cp;
             cp.normal = -hit.normal; // from the body vertex towards the face
             cp.velocity = (hit.p1 - hit.p0) / h;
             const Vec3 q1 = hit.w[0] * c1[0] + hit.w[1] * c1[1] + hit.w[2] * c1[2];
             cp.distance = cp.normal.dot(q1 - hit.p1);
-            for (int j = 0; j < 3; ++j) {
-                if (!(hit.w[j] > 0.05) || !free(tri[j]) ||
-                    !((v1[j] - cp.velocity).dot(cp.normal) < 0.0))
-                    continue;
-                const size_t i = static_cast<size_t>(tri[j]);
-                setContact(i, static_cast<int>(k), cp, c1[j], t1, thick + c.radius, t1, h, x0, v0,
-                           v1[j], false);
-                mContactMu[i] = c.friction;
-                mContactImpulse[i] = -(v1[j] - cp.velocity).dot(cp.normal);
-                mFoundInside[i] = 1;
-                ++st.contactAdded;
-                ++changes;
-            }
+            for (int j = 0; j < 3; ++j)
+                if (hit.w[j] > 0.05) hold(tri[j], cp, c1[j], v1[j]);
         }
     }
     syncFriction(v0, true);

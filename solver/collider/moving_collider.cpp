@@ -517,13 +517,17 @@ bool MovingMeshContact::firstEdgeHit(const Vec3& a0, const Vec3& a1, const Vec3&
     return true;
 }
 
+contact::CcdOptions MovingMeshContact::passOptions(double xi) const {
+    contact::CcdOptions o = sweepOptions(xi);
+    o.thickness += mRadius;
+    return o;
+}
+
 bool MovingMeshContact::edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
-                                    double thickness, EdgeHit& hit) const {
+                                    double thickness, std::vector<int>& cand, EdgeHit& hit) const {
     if (!mBuilt || !a0.allFinite() || !a1.allFinite() || !b0.allFinite() || !b1.allFinite())
         return false;
-    contact::CcdOptions opt = sweepOptions(thickness);
-    opt.thickness += mRadius;
-    std::vector<int> cand;
+    const contact::CcdOptions opt = passOptions(thickness);
     return firstEdgeHit(a0, a1, b0, b1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
 }
 
@@ -590,13 +594,11 @@ bool MovingMeshContact::firstFaceHit(const Vec3 c0[3], const Vec3 c1[3],
 }
 
 bool MovingMeshContact::faceContact(const Vec3 c0[3], const Vec3 c1[3], double thickness,
-                                    FaceHit& hit) const {
+                                    std::vector<int>& cand, FaceHit& hit) const {
     for (int k = 0; k < 3; ++k)
         if (!c0[k].allFinite() || !c1[k].allFinite()) return false;
     if (!mBuilt) return false;
-    contact::CcdOptions opt = sweepOptions(thickness);
-    opt.thickness += mRadius;
-    std::vector<int> cand;
+    const contact::CcdOptions opt = passOptions(thickness);
     return firstFaceHit(c0, c1, opt, opt.thickness + 2.0 * opt.gapTolerance, cand, hit);
 }
 
@@ -627,12 +629,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
     // placed at (ξ and ξ/2 as above; ξ_e below for pinned vertices within the thickness).
     // (A thin collider's centre or axis, setRadius: ξ measured from its surface, r out.)
     const auto placedAt = [&](double xi) { return xi * (1.0 + 1e-6) + 1e-9 + mRadius; };
-    const auto ccdFor = [&](double xi) {
-        contact::CcdOptions o = sweepOptions(xi);
-        o.thickness += mRadius;
-        return o;
-    };
-    const contact::CcdOptions opt = ccdFor(thickness);
+    const contact::CcdOptions opt = passOptions(thickness);
     // The broad phase's reach: the CCD asks for at most ξ/2 (less for pinned corners), and the
     // swept boxes hold each primitive throughout the step (its points are convex combinations
     // of its corners at both ends), so a pair whose boxes are farther apart than ξ/2 stays
@@ -722,7 +719,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             const int i = e[0], j = e[1];
             if (!movable[i] && !movable[j]) continue;
             const double xiE = std::min(clearanceOf(i), clearanceOf(j));
-            const contact::CcdOptions optE = ccdFor(xiE);
+            const contact::CcdOptions optE = passOptions(xiE);
             const double wantE = placedAt(xiE);
             const Vec3 a0 = vec3At(x0.data(), i), a1 = vec3At(x1.data(), i);
             const Vec3 b0 = vec3At(x0.data(), j), b1 = vec3At(x1.data(), j);
@@ -779,7 +776,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (!finite) continue; // left to the trouble detector
             const double xiT =
                 std::min({clearanceOf(tv[0]), clearanceOf(tv[1]), clearanceOf(tv[2])});
-            const contact::CcdOptions optT = ccdFor(xiT);
+            const contact::CcdOptions optT = passOptions(xiT);
             const double wantT = placedAt(xiT);
             auto tb = tick();
             FaceHit hit;

@@ -105,13 +105,14 @@ public:
 
     // The edge test of the continuous pass alone, for the solve's contacts (Body): the cloth edge
     // a0b0 → a1b1 against the body's edges, kept `thickness` off (from the surface r out of a
-    // thin collider's axis, setRadius). False when it meets none.
+    // thin collider's axis, setRadius). False when it meets none. `cand`: the caller's scratch.
     bool edgeContact(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
-                     double thickness, EdgeHit& hit) const;
+                     double thickness, std::vector<int>& cand, EdgeHit& hit) const;
 
     // The body vertex–cloth triangle test of the continuous pass alone (as edgeContact): the
     // triangle with corners c0 → c1 against the body's vertices.
-    bool faceContact(const Vec3 c0[3], const Vec3 c1[3], double thickness, FaceHit& hit) const;
+    bool faceContact(const Vec3 c0[3], const Vec3 c1[3], double thickness, std::vector<int>& cand,
+                     FaceHit& hit) const;
 
     // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
     // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
@@ -154,6 +155,9 @@ public:
 
 private:
     Vec3 corner(bool atEnd, int v) const;
+    // The continuous pass's CCD options for a primitive held ξ off the surface (r out of a thin
+    // collider's axis, setRadius).
+    contact::CcdOptions passOptions(double xi) const;
     // The face test for CCD options `opt`, candidates from the tree within `reach` (into cand).
     bool firstFaceHit(const Vec3 c0[3], const Vec3 c1[3], const contact::CcdOptions& opt,
                       double reach, std::vector<int>& cand, FaceHit& hit) const;
