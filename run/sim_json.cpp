@@ -168,7 +168,8 @@ std::string frameJson(const solver::FrameStats& f) {
           << "}, \"stretch_limit\": {\"substeps\": " << b.stretchLimitSubsteps
           << "}, \"contact_projection\": {\"vertices\": " << b.projected
           << ", \"max_distance\": " << num(b.projectedDistance)
-          << ", \"max_speed\": " << num(b.projectedSpeed) << "}";
+          << ", \"max_speed\": " << num(b.projectedSpeed) << ", \"relaxed\": " << b.sweepRelaxed
+          << "}";
         if (b.selfIntersections >= 0) o << ", \"self_intersections\": " << b.selfIntersections;
         o
           << ", \"failed\": " << (b.failed ? "true" : "false") << ", \"events\": [";

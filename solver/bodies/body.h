@@ -194,6 +194,7 @@ struct SubstepStatus {
     bool rotationProjected = false; // the projection ran in this substep
     bool stretchLimited = false;    // ... for edges beyond StepOptions::stretchLimit
     int projected = 0;
+    int sweepRelaxed = 0; // vertices moved to give back what the sweep stretched (relaxSwept)
     double projectedDistance = 0.0, projectedSpeed = 0.0;
 };
 
@@ -387,9 +388,18 @@ private:
     void landed();
     void rememberSliding(const VecX& v0, double h);
     void slide(size_t i, double c);
-    // The rotation-length projection of the linearised step (rotation_projection.h).
+    // The rotation-length projection of the linearised step (rotation_projection.h); with
+    // `constraints` in place of the body's own, and per-edge length caps and floors (m), when
+    // given.
     void projectRotations(const VecX& x0, const VecX& v0, double h, SubstepStatus& st,
-                          bool rotations, double stretchLimit, double tolerance);
+                          bool rotations, double stretchLimit, double tolerance,
+                          const Constraints* constraints = nullptr,
+                          const std::vector<double>* caps = nullptr,
+                          const std::vector<double>* floors = nullptr);
+    // What the continuous sweep (step 6) stretched, given back (its neighbours follow a swept
+    // vertex); returns the vertices moved.
+    int relaxSwept(const VecX& x0, const VecX& v0, const VecX& xBefore, double h,
+                   SubstepStatus& st);
     double slipOf(size_t i, const VecX& v0) const;
     int updateContacts(const Environment& env, double t, double h, const VecX& x0, const VecX& v0,
                        SubstepStatus& st);
@@ -498,6 +508,12 @@ private:
     // its edge and face tests in the solve's rounds (scratch).
     std::vector<std::shared_ptr<MovingMeshContact>> mThinContacts;
     std::vector<int> mThinCandidates;
+    // relaxSwept's scratch: the positions before the sweep, the directions it pushed the
+    // vertices it moved, the edges' caps and floors, the constraints with the pushes' planes.
+    VecX mSweepX;
+    std::vector<Vec3> mSweepNormals;
+    std::vector<double> mSweepCaps, mSweepFloors;
+    Constraints mSweepConstraints;
     // Per collider and vertex: the moving mesh's triangle its last query found closest (−1
     // none), the hint of its next query (the answer does not depend on it).
     std::vector<int> mNearTriangle;

@@ -37,7 +37,8 @@ RotationProjectionStats
 projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::vector<double>& rest,
                       const VecX& mass, const Constraints& constraints, const VecX& x0,
                       const VecX& v0, const VecX& y, double h, VecX& dv, double tolerance,
-                      const std::function<Vec3(int)>& hold, bool rotations, double stretchLimit) {
+                      const std::function<Vec3(int)>& hold, bool rotations, double stretchLimit,
+                      const std::vector<double>* caps, const std::vector<double>* floors) {
     RotationProjectionStats stats;
     const size_t n = static_cast<size_t>(mass.size());
     VecX x = x0 + h * (v0 + dv) + y;
@@ -55,10 +56,11 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         // Below the cap by the tolerance: an edge is left alone within it of its target.
         if (stretchLimit > 0.0)
             target[e] = std::min(target[e], (stretchLimit - tolerance) * rest[e]);
+        if (caps) target[e] = std::min(target[e], (*caps)[e]);
         if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
         const double excess = (len[e] - target[e]) / rest[e];
         worst = std::max(worst, excess);
-        if (excess > tolerance) ++beyond;
+        if (excess > tolerance || (floors && len[e] < (*floors)[e] - tolerance * rest[e])) ++beyond;
     }
     stats.excessBefore = stats.excessAfter = worst;
     stats.activeEdges = beyond;
@@ -86,7 +88,8 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     // vertices' edges, not a pass over the mesh.
     const auto penalty = [&](size_t e, double l) {
         const double ex = l - target[e];
-        return rest[e] > 0.0 && ex > 0.0 ? ex * ex : 0.0;
+        const double under = floors ? (*floors)[e] - l : 0.0;
+        return !(rest[e] > 0.0) ? 0.0 : ex > 0.0 ? ex * ex : under > 0.0 ? under * under : 0.0;
     };
     std::vector<int> incStart(n + 1, 0), incEdges(2 * edges.size());
     for (const auto& e : edges) {
@@ -109,7 +112,8 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     std::vector<int> active;
     std::vector<Vec3> dir, u;
     std::vector<double> c, lambda, r, z, p, q, diag;
-    const int maxIterations = stretchLimit > 0.0 ? kMaxLimitIterations : kMaxLateIterations;
+    const bool bound = stretchLimit > 0.0 || caps; // a bound, not a correction
+    const int maxIterations = bound ? kMaxLimitIterations : kMaxLateIterations;
     for (int it = 0; it < maxIterations; ++it) {
         active.clear();
         dir.clear();
@@ -119,9 +123,14 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         w.clear();
         double most = 0.0; // the largest relative excess of an active edge
         for (size_t e = 0; e < edges.size(); ++e) {
-            const double excess = len[e] - target[e];
-            if (!(excess > tolerance * rest[e]) || !(len[e] > 0.0) || !(rest[e] > 0.0)) continue;
-            most = std::max(most, excess / rest[e]);
+            // (Shorter than its floor: a negative excess, the same step lengthens it.)
+            double excess = len[e] - target[e];
+            if (floors && len[e] < (*floors)[e] - tolerance * rest[e])
+                excess = len[e] - (*floors)[e];
+            else if (!(excess > tolerance * rest[e]))
+                continue;
+            if (!(len[e] > 0.0) || !(rest[e] > 0.0)) continue;
+            most = std::max(most, std::abs(excess) / rest[e]);
             const auto [a, b] = edges[e];
             active.push_back(static_cast<int>(e));
             dir.push_back((at(x, b) - at(x, a)) / len[e]);
@@ -134,7 +143,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
                 }
         }
         if (active.empty()) break;
-        if (it >= kMaxIterations && stretchLimit <= 0.0 &&
+        if (it >= kMaxIterations && !bound &&
             !(most > std::max(kLateExcess, kLateTolerances * tolerance)))
             break;
         u.resize(verts.size());

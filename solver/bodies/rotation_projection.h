@@ -29,13 +29,16 @@ struct RotationProjectionStats {
 // constraint constraint filter S limits a vertex's motion (a pin or attachment moves not at all, a
 // contact only in its plane); a free one near a collider (hold(i), asked only for the vertices of
 // active edges: the collider's normal there, zero when none) only in the plane of that normal.
-// tolerance: relative excess (× rest) below which an edge is left alone.
-RotationProjectionStats projectRotationLength(const std::vector<std::array<int, 2>>& edges,
-                                              const std::vector<double>& rest, const VecX& mass,
-                                              const Constraints& constraints, const VecX& x0,
-                                              const VecX& v0, const VecX& y, double h, VecX& dv,
-                                              double tolerance,
-                                              const std::function<Vec3(int)>& hold = {},
-                                              bool rotations = true, double stretchLimit = 0.0);
+// tolerance: relative excess (× rest) below which an edge is left alone. caps (m, per edge; may
+// be null): every target capped at caps[e] as well (the lengths an edge had before a move that
+// stretched it: Body's projection after the continuous sweep); floors (m, per edge; may be null):
+// an edge shorter than floors[e] by more than the tolerance is lengthened to it as well.
+RotationProjectionStats
+projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::vector<double>& rest,
+                      const VecX& mass, const Constraints& constraints, const VecX& x0,
+                      const VecX& v0, const VecX& y, double h, VecX& dv, double tolerance,
+                      const std::function<Vec3(int)>& hold = {}, bool rotations = true,
+                      double stretchLimit = 0.0, const std::vector<double>* caps = nullptr,
+                      const std::vector<double>* floors = nullptr);
 
 } // namespace gale::solver

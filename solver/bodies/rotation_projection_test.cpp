@@ -104,3 +104,48 @@ TEST_CASE("stretch limit: with rotations off, only edges beyond the limit move",
     CHECK(s.activeEdges == 0);
     CHECK(e.dv == before);
 }
+
+TEST_CASE("rotation projection: per-edge caps and floors (a strand after the sweep)",
+          "[rotation]") {
+    // Caps: the edge pulled 8 % long along itself, capped at 2 % (no rotation targets): it ends
+    // at the cap within the tolerance, its pinned end where it was.
+    {
+        OneEdge e;
+        e.c.kind[0] = 1;
+        e.dv.segment<3>(3) = Vec3(0.008, 0.0, 0.0) / e.h;
+        const std::vector<double> caps{0.102};
+        projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-4, {},
+                              false, 0.0, &caps);
+        CHECK(e.end(0).norm() == 0.0);
+        CHECK((e.end(1) - e.end(0)).norm() == Approx(0.102).margin(1e-4 * 0.1));
+    }
+    // Floors: the edge pushed 10 % short; with a floor at its rest length it is lengthened back
+    // along its direction (equal masses: about its centre); without one it is left alone.
+    for (const bool floor : {true, false}) {
+        OneEdge e;
+        e.dv.segment<3>(3) = Vec3(-0.01, 0.0, 0.0) / e.h;
+        const Vec3 centre = 0.5 * (e.end(0) + e.end(1));
+        const std::vector<double> caps{0.1}, floors{0.1};
+        const RotationProjectionStats s =
+            projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-4,
+                                  {}, false, 0.0, &caps, floor ? &floors : nullptr);
+        CHECK(s.activeEdges == (floor ? 1 : 0));
+        CHECK((e.end(1) - e.end(0)).norm() == Approx(floor ? 0.1 : 0.09).margin(1e-4 * 0.1));
+        CHECK((0.5 * (e.end(0) + e.end(1)) - centre).norm() < 1e-12);
+    }
+    // A swept end held to the plane of its push (a contact plane, normal +y): it slides along x
+    // towards its neighbour, which moves too (mass-weighted), and does not move along y.
+    {
+        OneEdge e;
+        e.dv.segment<3>(3) = Vec3(0.01, 0.002, 0.0) / e.h; // 10 % long, lifted 2 mm
+        e.c.kind[1] = 2;
+        e.c.normal[3 * 1 + 1] = 1.0;
+        const double y1 = e.end(1).y();
+        const std::vector<double> caps{0.1};
+        projectRotationLength(e.edges, e.rest, e.mass, e.c, e.x0, e.v0, e.y, e.h, e.dv, 1e-4, {},
+                              false, 0.0, &caps);
+        CHECK(e.end(1).y() == Approx(y1).margin(1e-12));
+        CHECK((e.end(1) - e.end(0)).norm() == Approx(0.1).margin(1e-4 * 0.1));
+        CHECK(e.end(1).x() < 0.11 - 1e-3); // it slid back
+    }
+}

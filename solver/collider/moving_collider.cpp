@@ -415,13 +415,17 @@ int MovingMeshContact::endCrossings(const Vec3& a, const Vec3& b, bool first) co
     return crossings;
 }
 
-int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to) const {
+int MovingMeshContact::movesThroughSurface(const VecX& from, const VecX& to,
+                                           std::vector<int>* which) const {
     if (!mBuilt || from.size() != to.size()) return 0;
     int count = 0;
     for (Eigen::Index i = 0; 3 * i + 2 < from.size(); ++i) {
         const Vec3 a = vec3At(from.data(), i), b = vec3At(to.data(), i);
         if (a == b || !a.allFinite() || !b.allFinite()) continue;
-        if (endCrossings(a, b, true) > 0) ++count;
+        if (endCrossings(a, b, true) > 0) {
+            ++count;
+            if (which) which->push_back(static_cast<int>(i));
+        }
     }
     return count;
 }
@@ -606,7 +610,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                              const std::vector<uint8_t>& movable,
                              const std::vector<std::array<int, 2>>& edges,
                              const std::vector<std::array<int, 3>>& triangles, double thickness,
-                             double friction, double h, int passes) {
+                             double friction, double h, int passes, std::vector<Vec3>* normals) {
     if (!mBuilt) return 0;
     const auto sweepStart = std::chrono::steady_clock::now();
     // Per-primitive clocks (broad, narrow, face) only when asked for: two clock reads for every
@@ -654,6 +658,7 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
             if (ts > 0.0) u -= std::min(1.0, friction * (-un) / ts) * ut;
         }
         v = vs + u;
+        if (normals) (*normals)[static_cast<size_t>(i)] = n1;
         if (!moved[i]) {
             moved[i] = 1;
             ++movedCount;
@@ -824,11 +829,13 @@ int MovingMeshContact::sweep(const VecX& x0, VecX& x1, VecX& v1,
                         if (ts > 0.0) du -= std::min(1.0, friction * (-un) / ts) * ut;
                         for (int k = 0; k < 3; ++k) vec3At(v1.data(), tv[k]) += (wm[k] / norm) * du;
                     }
-                    for (int k = 0; k < 3; ++k)
+                    for (int k = 0; k < 3; ++k) {
+                        if (wm[k] > 0.0 && normals) (*normals)[static_cast<size_t>(tv[k])] = nc;
                         if (wm[k] > 0.0 && !moved[tv[k]]) {
                             moved[tv[k]] = 1;
                             ++movedCount;
                         }
+                    }
                     ++hits;
                     ++mStats.faceHits;
                 }

@@ -97,11 +97,12 @@ public:
     // of a cloth triangle, the triangle's movable corners are moved so that it ends `thickness` off
     // the body vertex, on the side it started, with the same velocity response at the point it met.
     // Repeated (at most `passes` times) until no motion meets the surface. Returns the vertices
-    // moved.
+    // moved. `normals` (when given, one per vertex): for each vertex moved, the unit direction
+    // its last hit pushed it (from the surface towards it); left as it was for the others.
     int sweep(const VecX& x0, VecX& x1, VecX& v1, const std::vector<uint8_t>& movable,
               const std::vector<std::array<int, 2>>& edges,
               const std::vector<std::array<int, 3>>& triangles, double thickness, double friction,
-              double h, int passes = 4);
+              double h, int passes = 4, std::vector<Vec3>* normals = nullptr);
 
     // The edge test of the continuous pass alone, for the solve's contacts (Body): the cloth edge
     // a0b0 → a1b1 against the body's edges, kept `thickness` off (from the surface r out of a
@@ -116,8 +117,10 @@ public:
 
     // Vertices whose straight move from[i] → to[i] (made after the step, at its end: the
     // self-collision pass) crosses the surface as it is at the end of the prepared step (a face
-    // between the two points). Vertices that did not move are not tested.
-    int movesThroughSurface(const VecX& from, const VecX& to) const;
+    // between the two points). Vertices that did not move are not tested. `which` (when given):
+    // their indices appended.
+    int movesThroughSurface(const VecX& from, const VecX& to,
+                            std::vector<int>* which = nullptr) const;
 
     // The vertex test of the continuous pass for a path p0 → p1 over the prepared step, as a
     // contact plane for the solve: when the path comes within ξ/2 of the surface (a crossing

@@ -101,6 +101,7 @@ struct BodyFrameStats {
     int contactAdded = 0, contactReleases = 0, contactSlides = 0, contactSolves = 0, projected = 0,
         contactsThrough = 0;
     double projectedDistance = 0.0, projectedSpeed = 0.0;
+    int sweepRelaxed = 0; // vertices moved to give back what the sweep stretched (strands)
     // Intersecting triangle pairs with a triangle of this body at the end of the frame, counted
     // when it takes part in cloth–cloth collision (−1: not counted).
     int selfIntersections = -1;
