@@ -229,10 +229,12 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
         // vertices that no collider saw).
         bool moving = false;
         for (const Collider& c : mColliders) moving = moving || c.moving;
-        std::vector<VecX> solved;
+        std::vector<VecX> solved, solvedV;
         if (moving)
-            for (size_t k = 0; k < n && k < mClothBodies; ++k)
+            for (size_t k = 0; k < n && k < mClothBodies; ++k) {
                 solved.push_back(mBodies[mSelfBodies[k]]->positions());
+                solvedV.push_back(mBodies[mSelfBodies[k]]->velocities());
+            }
         const SelfCollisionStats st = mSelf->resolve(starts);
         fs.selfContacts.add(st);
         bool stretched = false;
@@ -298,22 +300,26 @@ void World::advanceColliding(double t0, double dt, int substeps, FrameStats& fs)
             continue;
         }
         // Not halved again: the pass accepted but for those vertices, which keep the position
-        // the solve gave them (outside the body). A vertex left inside it is not pushed out
-        // reliably: the nearest surface of a thin part can be its far side (the storm cape of
-        // cli:cape_storm_body, so accepted at frame 1061, stayed caught inside the body for the
-        // rest of the shot).
+        // and velocity the solve gave them (outside the body). A vertex left inside it is not
+        // pushed out reliably: the nearest surface of a thin part can be its far side (the storm
+        // cape of cli:cape_storm_body, so accepted at frame 1061, stayed caught inside the body for
+        // the rest of the shot).
         if (pushedIn > 0) {
             for (size_t k = 0; k < through.size(); ++k) {
                 if (through[k].empty()) continue;
                 Body& body = *mBodies[mSelfBodies[k]];
-                VecX x = body.positions();
-                for (int i : through[k]) x.segment<3>(3 * i) = solved[k].segment<3>(3 * i);
+                VecX x = body.positions(), v = body.velocities();
+                for (int i : through[k]) {
+                    x.segment<3>(3 * i) = solved[k].segment<3>(3 * i);
+                    v.segment<3>(3 * i) = solvedV[k].segment<3>(3 * i);
+                }
                 body.setPositions(x);
+                body.setVelocities(v);
             }
             std::snprintf(buf, sizeof buf,
                           "t=%.6g s: self-collision pushed %d cloth vertex(es) through a moving "
                           "body's surface at a step halved %d time(s), no fewer than before the "
-                          "last halving: accepted, those vertices kept where the solve left them",
+                          "last halving: accepted, those vertices kept as the solve left them",
                           tEnd, pushedIn, level);
             for (size_t b : mSelfBodies) fs.bodies[b].events.push_back(buf);
         }
