@@ -707,10 +707,6 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
         const std::vector<std::array<int, 3>>* tris = collisionTriangles();
         // A strand's sweep is followed by relaxSwept (not a cloth's: see there).
         const bool relax = !tris && !mEdges.empty();
-        if (relax) {
-            mSweepX = mX;
-            mSweepNormals.assign(n, Vec3::Zero());
-        }
         std::vector<uint8_t> movable;
         const auto sweepAll = [&](std::vector<Vec3>* normals) {
             for (size_t k = 0; k < env.colliders->size(); ++k) {
@@ -720,10 +716,14 @@ SubstepStatus Body::substep(const Environment& env, double t, double h) {
                 MovingMeshContact* thin = c.moving ? nullptr : thinContact(k, c, mKin.t0, h);
                 MovingMeshContact* mesh = c.moving ? c.moving.get() : thin;
                 if (!mesh) continue;
-                if (movable.empty()) {
+                if (movable.empty()) { // the first sweep of the substep
                     movable.resize(n);
                     for (size_t i = 0; i < n; ++i)
                         movable[i] = mConstraints.kind[i] != 1 || mContactCollider[i] >= 0;
+                    if (relax) {
+                        mSweepX = mX;
+                        mSweepNormals.assign(n, Vec3::Zero());
+                    }
                 }
                 st.projected += mesh->sweep(x0, mX, mV, movable, mEdges, tris ? *tris : noTriangles,
                                             colliderThickness(c), c.friction, h, 4, normals);
@@ -863,25 +863,22 @@ int Body::relaxSwept(const VecX& x0, const VecX& v0, const VecX& xBefore, double
     const auto lengthOf = [&](const VecX& x, size_t e) {
         return (vec3At(x.data(), mEdges[e][1]) - vec3At(x.data(), mEdges[e][0])).norm();
     };
+    mSweepCaps.resize(mEdges.size());
+    mSweepFloors.resize(mEdges.size());
     bool any = false;
     for (size_t e = 0; e < mEdges.size(); ++e) {
-        if (!(mEdgeRest[e] > 0.0)) continue;
-        const double before = lengthOf(xBefore, e), after = lengthOf(mX, e);
+        const double rest = mEdgeRest[e], before = lengthOf(xBefore, e);
+        mSweepCaps[e] = std::max(rest, before);
+        mSweepFloors[e] = std::min(rest, before);
+        if (!(rest > 0.0)) continue;
+        const double after = lengthOf(mX, e);
         // A segment the sweep took beyond the over-stretch limit is trouble (the detector's
         // rules, step 7: the substep is done again at half the step), not a length to give
         // back: the neighbours of a vertex dragged a metre by a collider would follow it.
-        if (after > mLimits.overStretch * mEdgeRest[e]) return 0;
-        any = any || after > std::max(before, mEdgeRest[e]) + tol * mEdgeRest[e] ||
-              after < std::min(before, mEdgeRest[e]) - tol * mEdgeRest[e];
+        if (after > mLimits.overStretch * rest) return 0;
+        any = any || after > mSweepCaps[e] + tol * rest || after < mSweepFloors[e] - tol * rest;
     }
     if (!any) return 0;
-    mSweepCaps.resize(mEdges.size());
-    mSweepFloors.resize(mEdges.size());
-    for (size_t e = 0; e < mEdges.size(); ++e) {
-        const double before = lengthOf(xBefore, e);
-        mSweepCaps[e] = std::max(mEdgeRest[e], before);
-        mSweepFloors[e] = std::min(mEdgeRest[e], before);
-    }
     // A swept vertex moves only in the plane of its push (a contact plane with the push's
     // direction as its normal; held where it already had one): it may slide, not go back.
     mSweepConstraints = mConstraints;
@@ -895,8 +892,8 @@ int Body::relaxSwept(const VecX& x0, const VecX& v0, const VecX& xBefore, double
     const VecX dvKeep = mDv;
     mDv = (mX - x0 - mYPos) / h - v0;
     const VecX dvSwept = mDv;
-    SubstepStatus scratch = st;
-    projectRotations(x0, v0, h, scratch, false, 0.0, tol, &mSweepConstraints, &mSweepCaps,
+    // (With no rotation targets and no stretch limit it records nothing in st.)
+    projectRotations(x0, v0, h, st, false, 0.0, tol, &mSweepConstraints, &mSweepCaps,
                      &mSweepFloors);
     int moved = 0;
     for (size_t i = 0; i < n; ++i) {

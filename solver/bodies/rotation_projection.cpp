@@ -47,6 +47,10 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     std::vector<double> target(edges.size()), len(edges.size()); // len: |x_b − x_a| at x
     int beyond = 0;
     double worst = 0.0;
+    // Shorter than its floor by more than the tolerance (floors given).
+    const auto belowFloor = [&](size_t e, double l) {
+        return floors && l < (*floors)[e] - tolerance * rest[e];
+    };
     for (size_t e = 0; e < edges.size(); ++e) {
         const auto [a, b] = edges[e];
         const Vec3 d0 = at(x0, b) - at(x0, a), d1 = at(x, b) - at(x, a);
@@ -60,7 +64,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         if (!(rest[e] > 0.0)) continue; // a degenerate edge: left alone
         const double excess = (len[e] - target[e]) / rest[e];
         worst = std::max(worst, excess);
-        if (excess > tolerance || (floors && len[e] < (*floors)[e] - tolerance * rest[e])) ++beyond;
+        if (excess > tolerance || belowFloor(e, len[e])) ++beyond;
     }
     stats.excessBefore = stats.excessAfter = worst;
     stats.activeEdges = beyond;
@@ -125,7 +129,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         for (size_t e = 0; e < edges.size(); ++e) {
             // (Shorter than its floor: a negative excess, the same step lengthens it.)
             double excess = len[e] - target[e];
-            if (floors && len[e] < (*floors)[e] - tolerance * rest[e])
+            if (belowFloor(e, len[e]))
                 excess = len[e] - (*floors)[e];
             else if (!(excess > tolerance * rest[e]))
                 continue;
