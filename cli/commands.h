@@ -86,7 +86,7 @@ struct SampleOptions {
     std::string res;        // N (cubic voxels, N along the longest side) or NX,NY,NZ
     double voxel = 0.0;     // cubic voxel size (instead of --res)
     double time = 0.0;      // seconds
-    std::string frames;     // A:B (t = frame / fps), OUT has '#'
+    std::string frames;     // A:B (t = (frame − time_zero) / fps), OUT has '#'
     double fps = 0.0;       // 0: the scene's, else 24
     int threads = 0;        // 0: all hardware threads
     std::string output;     // -o OUT ("-" or empty: stdout)

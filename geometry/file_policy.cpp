@@ -205,9 +205,10 @@ bool findFiles(const FileAccess& access, const std::string& name, FileRef& out,
         ref.frames.push_back(std::move(f));
     }
     if (ref.frames.empty()) {
-        error = "no files of the sequence '" + name + "' in " + dir.string() + " (frame 1 would be " +
-                io::formatFrame(pattern, 1) + "; frame numbers are written as " + io::kFrameTokens +
-                ")";
+        error = "no files of the sequence '" + name + "' in " + dir.string() +
+                " (frame 1 would be " + io::formatFrame(pattern, 1) + ", frame 1001 " +
+                io::formatFrame(pattern, 1001) + "; frame numbers are written as " +
+                io::kFrameTokens + ")";
         return false;
     }
     std::sort(ref.frames.begin(), ref.frames.end(),

@@ -76,6 +76,20 @@ std::string settingsJson(const scene::SimScene& sc,
     for (size_t i = 0; i < sc.wind.fields.size(); ++i)
         o << (i ? ", " : "") << jsonString(sc.wind.fields[i].name);
     o << "], \"objects\": [";
+    // The vertices bound to a body's surface (hard or soft `attach`) and the attachment's
+    // stiffness (N/m; 0: hard).
+    const auto attachJson = [&](const Body* b) {
+        size_t attached = 0;
+        double stiffness = 0.0;
+        if (b)
+            for (const solver::PinSet& set : b->pinSets())
+                if (set.attach) {
+                    attached += set.vertices.size();
+                    stiffness = set.stiffness;
+                }
+        return ", \"attached\": " + std::to_string(attached) +
+               ", \"attach_stiffness\": " + num(stiffness);
+    };
     size_t bi = 0;
     for (const scene::ClothSpec& c : sc.cloths) {
         const Body* b = bi < bodies.size() ? bodies[bi++].get() : nullptr;
@@ -84,7 +98,7 @@ std::string settingsJson(const scene::SimScene& sc,
           << ", \"kind\": \"cloth\", \"geometry\": "
           << (c.meshPath.empty() ? "\"grid\"" : jsonString(c.meshPath))
           << ", \"vertices\": " << (b ? b->vertexCount() : 0)
-          << ", \"pinned\": " << (b ? b->pinnedVertices().size() : 0)
+          << ", \"pinned\": " << (b ? b->pinnedVertices().size() : 0) << attachJson(b)
           << ", \"density\": " << num(m.density) << ", \"stretch\": " << paramJson(m.stretch, t0)
           << ", \"shear\": " << paramJson(m.shear, t0) << ", \"bend\": " << paramJson(m.bend, t0)
           << ", \"damping\": " << paramJson(m.damping, t0)
@@ -107,8 +121,9 @@ std::string settingsJson(const scene::SimScene& sc,
         o << (bi > 1 ? ", " : "") << "{\"name\": " << jsonString(h.name)
           << ", \"kind\": \"hair\", \"geometry\": "
           << (h.strandsPath.empty() ? "\"grid\"" : jsonString(h.strandsPath))
-          << ", \"vertices\": " << (b ? b->vertexCount() : 0) << ", \"radius\": " << num(m.radius)
-          << ", \"density\": " << num(m.density) << ", \"stretch\": " << paramJson(m.stretch, t0)
+          << ", \"vertices\": " << (b ? b->vertexCount() : 0) << attachJson(b)
+          << ", \"radius\": " << num(m.radius) << ", \"density\": " << num(m.density)
+          << ", \"stretch\": " << paramJson(m.stretch, t0)
           << ", \"bend\": " << paramJson(m.bend, t0)
           << ", \"damping\": " << paramJson(m.damping, t0)
           << ", \"drag_normal\": " << paramJson(h.dragNormal.value, t0)

@@ -28,6 +28,19 @@ using namespace gale::solver;
 
 namespace {
 
+// Where a key's value was written, for the errors the build gives later (a mesh that cannot be
+// read): its line and column in the scene file, or (line 0) the --set that gave it.
+void keyPlace(const toml::node& n, int& line, int& col, std::string& origin) {
+    const auto& path = n.source().path;
+    if (path && path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
+        origin = *path;
+        line = col = 0;
+        return;
+    }
+    line = static_cast<int>(n.source().begin.line);
+    col = static_cast<int>(n.source().begin.column);
+}
+
 // Generated cloth and hair grids: at most this many vertices (a million already takes the
 // implicit solver minutes a frame and gigabytes).
 constexpr long long kMaxGridVertices = 1LL << 20;
@@ -431,6 +444,7 @@ void Loader::loadCloth(const toml::table& t, size_t index, const std::string& ba
         std::string file;
         if (string(*mesh, what + ": mesh", file))
             c.meshPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+        keyPlace(*mesh, c.meshLine, c.meshCol, c.meshOrigin);
     } else if (const toml::table* g = grid->as_table()) {
         checkKeys(*g, {"size", "res", "origin", "axes"}, what + " grid");
         std::vector<double> v;
@@ -525,6 +539,7 @@ void Loader::loadHair(const toml::table& t, size_t index, const std::string& bas
         std::string file;
         if (string(*strands, what + ": strands", file))
             h.strandsPath = (std::filesystem::path(baseDir) / file).lexically_normal().string();
+        keyPlace(*strands, h.strandsLine, h.strandsCol, h.strandsOrigin);
     } else if (const toml::table* g = grid->as_table()) {
         checkKeys(*g, {"size", "count", "length", "segments", "origin", "direction"}, what + " grid");
         std::vector<double> v;
@@ -661,9 +676,13 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
     if (io::hasFrameToken(path)) {
         // A per-frame sequence ('#' run, %04d or $F4): triangles, a refitted tree and continuous contact
         // (solver/collider/moving_collider.h) instead of an SDF rebuilt every frame.
+        if (const toml::node* n = t.get("voxel"))
+            error(*n, what +
+                          ": 'voxel' does not apply to a mesh sequence (its contact is against "
+                          "the triangles themselves; voxel sizes a static mesh's SDF): remove it");
         std::shared_ptr<const MeshSequence> seq = MeshSequence::load(path, settings.fps, problem, settings.timeZero);
         if (!seq) {
-            error(*mesh, what + ": " + problem);
+            error(*mesh, what + ": " + problem).io = isFileProblem(problem);
             return;
         }
         if (const toml::node* r = t.get("rest_mesh")) {
@@ -672,7 +691,7 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
             if (!string(*r, what + ": rest_mesh", restFile)) return;
             TriMesh m;
             if (!loadMesh(sceneFile(restFile), m, problem)) {
-                error(*r, what + ": rest_mesh: " + problem);
+                error(*r, what + ": rest_mesh: " + problem).io = isFileProblem(problem);
                 return;
             }
             if (m.vertexCount() != seq->vertexCount() || m.triangles != seq->triangles()) {
@@ -695,9 +714,10 @@ void Loader::loadCollider(const toml::table& t, size_t index, const fields::Scen
     c.mesh = MeshCollider::load(path, voxel, problem);
     if (!c.mesh) {
         std::error_code ec;
-        if (!std::filesystem::exists(path, ec))
+        const bool missing = !std::filesystem::exists(path, ec);
+        if (missing)
             problem += io::foreignTokenHint(std::filesystem::path(file).filename().string());
-        error(*mesh, what + ": " + problem);
+        error(*mesh, what + ": " + problem).io = missing || isFileProblem(problem);
         return;
     }
     if (const toml::node* r = t.get("rest_mesh"))

@@ -5,6 +5,7 @@
 
 #include "scene/sections.h"
 #include "scene/toml_reader.h"
+#include "scene/toml_util.h"
 
 #include <filesystem>
 #include <sstream>
@@ -53,6 +54,34 @@ bool SceneDocument::applySets(const std::vector<std::string>& sets,
                          "field.NAME.params.PARAM, cloth.NAME.drag or solver.max_halvings";
     reader.applySets(m->root, sets, sections);
     return errors.size() == before;
+}
+
+std::string SceneDocument::canonicalSetKey(const std::string& set) const {
+    const std::string key = trimText(set.substr(0, set.find('=')));
+    std::vector<std::string> parts = splitText(key, '.');
+    if (parts.size() < 3) return key;
+    const std::string& head = parts[0];
+    if (head != "gust" && head != "field" && head != "cloth" && head != "hair" &&
+        head != "collider")
+        return key;
+    const toml::array* list = m->root.get(head) ? m->root.get(head)->as_array() : nullptr;
+    if (!list) return key;
+    for (size_t i = 0; i < list->size(); ++i) {
+        const toml::table* t = list->get(i)->as_table();
+        if (!t) continue;
+        // (As applySets names entries: a gust has no default name, only its index.)
+        const std::string name = t->get("name") && t->get("name")->is_string()
+                                     ? t->get("name")->value<std::string>().value_or("")
+                                 : head == "gust" ? std::string()
+                                                  : head + std::to_string(i);
+        if ((!name.empty() && name == parts[1]) || parts[1] == std::to_string(i)) {
+            parts[1] = std::to_string(i);
+            std::string out = parts[0];
+            for (size_t k = 1; k < parts.size(); ++k) out += "." + parts[k];
+            return out;
+        }
+    }
+    return key;
 }
 
 namespace {

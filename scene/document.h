@@ -41,6 +41,12 @@ public:
     // override that cannot be applied is an error naming it; false when there were any.
     bool applySets(const std::vector<std::string>& sets, std::vector<SceneError>& errors);
 
+    // The key of a `--set KEY=VALUE` (the part before '='), with a [[gust]], [[field]], [[cloth]],
+    // [[hair]] or [[collider]] entry named by its index as applySets resolves it (by name, the
+    // default `cloth0`-style names, or its index): `cloth.cape.stretch` and `cloth.0.stretch`
+    // give one key for the same entry. Otherwise the key as written (trimmed).
+    std::string canonicalSetKey(const std::string& set) const;
+
     // Every relative file name the scene's schema knows (a field's expr, a cloth's mesh and
     // rest_mesh, a hair's strands, painted-map exprs, a collider's mesh, an attachment's mesh)
     // made absolute against the scene's folder, so that the document can be written elsewhere.

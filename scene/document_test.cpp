@@ -167,3 +167,20 @@ TEST_CASE("scene document: parameter literals and named files", "[scene][documen
     const std::vector<std::string> other = doc.otherPaths();
     CHECK(std::find(other.begin(), other.end(), d + "breeze") != other.end());
 }
+
+TEST_CASE("scene document: one key for both spellings of a --set", "[scene][document]") {
+    Fixture f;
+    SceneDocument doc;
+    std::vector<SceneError> errors;
+    REQUIRE(doc.read(f.scene, errors));
+    // By name and by index: the same entry, whatever the value.
+    CHECK(doc.canonicalSetKey("cloth.cape.drag=0.8") == doc.canonicalSetKey("cloth.0.drag=1"));
+    CHECK(doc.canonicalSetKey("field.breeze.params.speed=7") == "field.0.params.speed");
+    CHECK(doc.canonicalSetKey(" collider.ground.friction = 0.1") == "collider.0.friction");
+    // Different entries, keys or sections stay apart; what the scene does not name is kept.
+    CHECK(doc.canonicalSetKey("cloth.cape.drag=1") != doc.canonicalSetKey("cloth.cape.lift=1"));
+    CHECK(doc.canonicalSetKey("cloth.nobody.drag=1") == "cloth.nobody.drag");
+    CHECK(doc.canonicalSetKey("cloth.1.drag=1") == "cloth.1.drag");
+    CHECK(doc.canonicalSetKey("scene.fps=30") == "scene.fps");
+    CHECK(doc.canonicalSetKey("windicator.speed=3") == "windicator.speed");
+}

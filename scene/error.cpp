@@ -48,4 +48,12 @@ std::string SceneError::render() const {
     return out;
 }
 
+bool isFileProblem(const std::string& message) {
+    for (const char* said :
+         {"cannot open", "cannot read '", "No such file", "no files of the sequence",
+          "' is missing", "cannot list the folder", "which does not exist", "Permission denied"})
+        if (message.find(said) != std::string::npos) return true;
+    return false;
+}
+
 } // namespace gale::scene

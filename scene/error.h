@@ -28,4 +28,8 @@ struct SceneError {
 // An error at file:line:col of `file`, its source line read from the file.
 SceneError sceneErrorAt(const std::string& file, int line, int col, std::string message);
 
+// Whether a loader's message (loadMesh, MeshSequence::load, loadStrands) says a file could not be
+// found or read, rather than that its contents are wrong: such a SceneError is `io` (exit 3).
+bool isFileProblem(const std::string& message);
+
 } // namespace gale::scene

@@ -3,6 +3,7 @@
 
 #include "io/frame_pattern.h"
 
+#include "solver/collider/mesh_collider.h"
 #include "solver/collider/moving_collider.h"
 #include "solver/world/frame_trouble.h"
 #include "solver/world/self_collision.h"
@@ -60,15 +61,28 @@ std::string metres(double v) {
 
 // Where a collider's surface can be over the run: every frame of a sequence, or an analytic
 // shape at the run's start (an empty box for planes and static meshes: not looked at).
-Box colliderBox(const solver::Collider& c, double t0) {
+// The box a collider covers: a sequence's over all its frames (where it goes), a static mesh's
+// bounds, an analytic shape's at t0. `size`, when given: how large the body itself is (a
+// sequence's largest box of one frame, not the ground it covers walking).
+Box colliderBox(const solver::Collider& c, double t0, double* size = nullptr) {
     Box b;
+    if (size) *size = 0.0;
     if (c.moving) {
         const solver::MeshSequence& seq = c.moving->mesh();
         std::vector<double> x;
         for (long f = seq.firstFrame(); f <= seq.lastFrame(); ++f) {
             seq.positionsAt(seq.frameTime(static_cast<double>(f)), x);
-            b.add(boxOf(x));
+            const Box frame = boxOf(x);
+            if (size) *size = std::max(*size, frame.extent());
+            b.add(frame);
         }
+        return b;
+    }
+    if (c.mesh) {
+        const std::array<double, 6>& m = c.mesh->sdf().meshBounds();
+        b.add(Vec3(m[0], m[1], m[2]));
+        b.add(Vec3(m[3], m[4], m[5]));
+        if (size) *size = b.extent();
         return b;
     }
     if (c.shape == solver::ColliderShape::Sphere || c.shape == solver::ColliderShape::Capsule) {
@@ -80,6 +94,7 @@ Box colliderBox(const solver::Collider& c, double t0) {
             b.add(p.b - r);
             b.add(p.b + r);
         }
+        if (size) *size = b.extent();
     }
     return b;
 }
@@ -160,19 +175,32 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         for (const auto& g : gaps)
             far += g.second > std::max(kBindGapFloor, kBindGapShare * extent);
         const char* kind = what.rfind("[[hair]]", 0) == 0 ? "hair" : "cloth";
-        out.push_back(specError(
-            scene.wind.path, key,
-            what + " attach: vertex " + std::to_string(worst->first) + " is bound " +
-                metres(worst->second) + " m from the body's surface at frame " +
-                std::to_string(first) + " (" + std::to_string(far) + " of " +
-                std::to_string(gaps.size()) + " bound vertices farther than " +
-                metres(std::max(kBindGapFloor, kBindGapShare * extent)) + " m; the " + kind +
-                " spans " + metres(extent) +
-                " m): it rides that far beside the body all run; are the two "
-                "in the same units, and does the body stand where the " +
-                kind +
-                " was modelled at that frame (scene.preroll eases it there from its rest pose)?",
-            true));
+        // Bound at the first simulated frame (the shot's start, or an earlier --frames start,
+        // SimRun): the pre-roll's first under a pre-roll, where the body stands in its rest
+        // pose (the collider's rest_mesh, else the sequence's first file).
+        const bool preroll = s.preroll > 0;
+        const int bindFrame = std::min(first, s.frameStart) - s.preroll;
+        const std::string where =
+            "at frame " + std::to_string(bindFrame) +
+            (preroll ? " (the pre-roll's first, the body in its rest pose)" : "");
+        const std::string hint =
+            preroll
+                ? std::string(" was modelled on the body's rest pose (the collider's rest_mesh, "
+                              "else the sequence's first file)?")
+                : std::string(" was modelled at that frame (scene.preroll eases it there "
+                              "from its rest pose)?");
+        out.push_back(specError(scene.wind.path, key,
+                                what + " attach: vertex " + std::to_string(worst->first) +
+                                    " is bound " + metres(worst->second) +
+                                    " m from the body's surface " + where + " (" +
+                                    std::to_string(far) + " of " + std::to_string(gaps.size()) +
+                                    " bound vertices farther than " +
+                                    metres(std::max(kBindGapFloor, kBindGapShare * extent)) +
+                                    " m; the " + kind + " spans " + metres(extent) +
+                                    " m): it rides that far beside the body all run; are the two "
+                                    "in the same units, and does the body stand where the " +
+                                    kind + hint,
+                                true));
     };
     for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i)
         if (scene.cloths[i].hasAttach)
@@ -397,9 +425,10 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
     for (const solver::Collider& c : scene.colliders) {
         const std::string what = "[[collider]] '" + c.name + "'";
         if (c.moving) checkSequence(c.moving->mesh(), c.line, c.col, what);
-        const Box box = colliderBox(c, s.frameTime(first));
+        double size = 0.0;
+        const Box box = colliderBox(c, s.frameTime(first), &size);
         if (box.empty() || cloth.empty() || !(clothExtent > 0.0)) continue;
-        checkScale(box.extent(), c.line, c.col, what);
+        checkScale(size, c.line, c.col, what);
         double nearest = std::numeric_limits<double>::infinity();
         for (const Box& b : bodyBoxes) nearest = std::min(nearest, box.gap(b));
         // Reach: twice the cloth's size, and as far as a body falls over the run (½ g T²: a

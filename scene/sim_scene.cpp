@@ -45,6 +45,20 @@ SceneError sceneError(const SimScene& scene, int line, int col, std::string mess
     return sceneErrorAt(scene.wind.path, line, col, std::move(message));
 }
 
+// An error at a key: the --set that gave it (`origin`), else its line and column, else (line 0)
+// its section's header at `line0`, `col0`.
+SceneError keyError(const SimScene& scene, const std::string& origin, int line, int col, int line0,
+                    int col0, std::string message) {
+    if (!origin.empty()) {
+        SceneError e;
+        e.file = origin;
+        e.message = std::move(message);
+        return e;
+    }
+    return line > 0 ? sceneError(scene, line, col, std::move(message))
+                    : sceneError(scene, line0, col0, std::move(message));
+}
+
 Vec3 axisOf(char c) {
     return c == 'x' ? Vec3::UnitX() : c == 'y' ? Vec3::UnitY() : Vec3::UnitZ();
 }
@@ -353,9 +367,9 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             std::string error;
             int dropped = 0;
             if (!loadMesh(spec.meshPath, mesh, error, &dropped)) {
-                SceneError e = sceneError(scene, spec.line, spec.col, what + ": " + error);
-                e.io = error.find("cannot open") != std::string::npos ||
-                       error.find("No such file") != std::string::npos;
+                SceneError e = keyError(scene, spec.meshOrigin, spec.meshLine, spec.meshCol,
+                                        spec.line, spec.col, what + ": " + error);
+                e.io = isFileProblem(error);
                 errors.push_back(std::move(e));
                 continue;
             }
@@ -377,7 +391,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             if (!loadMesh(spec.restMeshPath, restMesh, error)) {
                 SceneError e =
                     sceneError(scene, spec.restLine, spec.restCol, where + ": " + error);
-                e.io = true;
+                e.io = isFileProblem(error);
                 errors.push_back(std::move(e));
                 continue;
             }
@@ -450,6 +464,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             if (!att.attach) {
                 errors.push_back(
                     specError(scene.wind.path, spec.attach, what + " attach: " + problem));
+                errors.back().io = isFileProblem(problem);
                 ok = false;
             }
             ok = selectVertices(scene, spec.attach, what + " attach", mesh.positions,
@@ -474,7 +489,10 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         } else {
             std::string error;
             if (!loadStrands(spec.strandsPath, strands, error)) {
-                errors.push_back(sceneError(scene, spec.line, spec.col, what + ": " + error));
+                errors.push_back(keyError(scene, spec.strandsOrigin, spec.strandsLine,
+                                          spec.strandsCol, spec.line, spec.col,
+                                          what + ": " + error));
+                errors.back().io = isFileProblem(error);
                 continue;
             }
         }
@@ -519,6 +537,7 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             if (!att.attach) {
                 errors.push_back(
                     specError(scene.wind.path, spec.attach, what + " attach: " + problem));
+                errors.back().io = isFileProblem(problem);
                 continue;
             }
             std::vector<int> chosen;

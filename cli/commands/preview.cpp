@@ -6,6 +6,7 @@
 #include "cli/common.h"
 #include "cli/wedge/wedge.h"
 #include "fields/grid_sample.h"
+#include "scene/document.h"
 #include "scene/load.h"
 #include "scene/sim_scene.h"
 #include "solver/collider/moving_collider.h"
@@ -268,8 +269,14 @@ int runVizFrames(const VizOptions& o) {
     SourceOptions source = o.source;
     const std::vector<std::string> runSets = recordedSets(dir);
     if (!runSets.empty()) {
-        // Said as applied: a key given here again wins over the run's (it comes later).
-        const auto keyOf = [](const std::string& set) { return set.substr(0, set.find('=')); };
+        // Said as applied: a key given here again wins over the run's (it comes later). Keys
+        // compare as the scene resolves them (cloth.cape.stretch is cloth.0.stretch).
+        scene::SceneDocument doc;
+        std::vector<scene::SceneError> ignored; // (an unreadable scene is said when it loads)
+        const bool read = doc.read(o.source.file, ignored);
+        const auto keyOf = [&](const std::string& set) {
+            return read ? doc.canonicalSetKey(set) : set.substr(0, set.find('='));
+        };
         std::string kept, replaced;
         for (const std::string& s : runSets) {
             const bool again =

@@ -275,10 +275,11 @@ Command addSampleCommand(CLI::App& app) {
     CLI::Option* time =
         sub->add_option("--time", o->time, "$t in seconds (default 0)")->type_name("T");
     CLI::Option* frames =
-        sub->add_option("--frames", o->frames,
-                        "Sample frames A to B (inclusive) at t = frame / fps, one file each: "
-                        "the '#' run in -o becomes the frame number (a lone '#' pads to 4 "
-                        "digits, '##' to 2, ...)")
+        sub->add_option(
+               "--frames", o->frames,
+               "Sample frames A to B (inclusive) at t = (frame - time_zero) / fps, one file each: "
+               "the '#' run in -o becomes the frame number (a lone '#' pads to 4 "
+               "digits, '##' to 2, ...)")
             ->type_name("A:B");
     time->excludes(frames);
     frames->excludes(time);

@@ -44,12 +44,18 @@ bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dr
     io::PointSet ps;
     io::IoError e = io::readPoints(path, ps);
     if (e) {
-        error = e.render();
+        // "file:line:col: message": the caller's diagnostic says "error:" once.
+        std::string where = e.file.empty() ? path : e.file;
+        if (e.line > 0) {
+            where += ':' + std::to_string(e.line);
+            if (e.col > 0) where += ':' + std::to_string(e.col);
+        }
+        error = where + ": " + e.message;
         return false;
     }
     const int ix = ps.find("x"), iy = ps.find("y"), iz = ps.find("z");
     if (ix < 0 || iy < 0 || iz < 0) {
-        error = path + ": error: the mesh has no x, y, z vertex coordinates";
+        error = path + ": the mesh has no x, y, z vertex coordinates";
         return false;
     }
     const size_t n = ps.size();
@@ -62,9 +68,9 @@ bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dr
         // (OBJ's reader checks its v lines; a PLY's binary floats can still hold NaN or ∞.)
         for (int k = 0; k < 3; ++k)
             if (!std::isfinite(out.positions[3 * i + k])) {
-                error = path + ": error: vertex " + std::to_string(i + 1) +
-                        " (counting from 1) has a " + "non-finite " + "xyz"[k] + " (" +
-                        std::to_string(out.positions[3 * i + k]) + "): re-export the mesh";
+                error = path + ": vertex " + std::to_string(i + 1) + " (counting from 1) has a " +
+                        "non-finite " + "xyz"[k] + " (" + std::to_string(out.positions[3 * i + k]) +
+                        "): re-export the mesh";
                 return false;
             }
     }
@@ -104,7 +110,7 @@ bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dr
     }
     if (dropped) *dropped = bad;
     if (out.triangles.empty()) {
-        error = path + ": error: the mesh has no usable faces (cloth needs triangles or polygons)";
+        error = path + ": the mesh has no usable faces (it needs triangles or polygons)";
         return false;
     }
     return true;

@@ -42,7 +42,7 @@ awk -v y="$lowest" 'BEGIN { exit !(y > 1.5 && y < 1.75) }' || fail "the sheet re
 
 sed -i 's/mesh = "body.obj"/mesh = "nobody.obj"/' scene.toml
 run "$GALE" sim scene.toml -o out2
-expect_rc 1 "a missing collider mesh"
+expect_rc 3 "a missing collider mesh (a missing file: exit 3, spec cli.md)"
 expect_match "$ERR" "^scene.toml:19:8: error: \[\[collider\]\] 'body': cannot read 'nobody.obj'" "at the key"
 
 finish

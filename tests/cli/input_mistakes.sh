@@ -125,14 +125,14 @@ rm linked/box.0003.obj
 ln -s /nonexistent/cache/box.0003.obj linked/box.0003.obj
 scene linked/box.#.obj > dangling.toml
 run "$GALE" check dangling.toml
-expect_rc 1 "a dangling frame link"
+expect_rc 3 "a dangling frame link (a missing file: exit 3, spec cli.md)"
 expect_match "$ERR" "dangling.toml:9:[0-9]+: .*'box.0003.obj' .* is a link to /nonexistent/cache/box.0003.obj, which does not exist" \
     "the error names the link and its target"
 
 # Houdini's ${F4} (not one of gale's spellings).
 scene 'body/box.${F4}.obj' > braces.toml
 run "$GALE" check braces.toml
-expect_rc 1 "an unknown frame token"
+expect_rc 3 "an unknown frame token (no such file)"
 expect_match "$ERR" "write the frame number as .*#.*%04d.*\\\$F4" "the error lists the tokens gale reads"
 # A collider named with another program's token (read as one static file that is not there):
 # the same list, at the collider's mesh key; with a rest_mesh beside it, still the mesh's error.
@@ -141,7 +141,7 @@ for token in '<F>' '{frame:04d}'; do
     for rest in "" 'rest_mesh = "body/box.0001.obj"'; do
         { cat tok.toml; echo "$rest"; } > tok2.toml
         run "$GALE" check tok2.toml
-        expect_rc 1 "a collider's sequence written box.$token.obj ${rest:+(with a rest_mesh)}"
+        expect_rc 3 "a collider's sequence written box.$token.obj ${rest:+(with a rest_mesh)}"
         expect_match "$ERR" "tok2.toml:15:[0-9]+: error: .*cannot read 'body/box\.$token\.obj'.*write the frame number as .*#.*%04d" \
             "the collider's error lists the tokens gale reads ($token${rest:+, with a rest_mesh})"
         expect_no_match "$ERR" "a static mesh does not move" "no rest_mesh error hides it ($token)"
@@ -150,7 +150,7 @@ done
 
 # A --set that names a mesh that is not there: said at the --set, not at the scene's attach line.
 run "$GALE" check short.toml --set cloth.c.attach.mesh=nowhere.obj
-expect_rc 1 "an attach mesh from --set that does not exist"
+expect_rc 3 "an attach mesh from --set that does not exist"
 expect_match "$ERR" "^--set cloth.c.attach.mesh=nowhere.obj: error: .*cannot read 'nowhere.obj'" \
     "the error is at the --set"
 

@@ -6,10 +6,11 @@
 source "$(dirname "$0")/lib.bash" "$@"
 
 # A box body sliding along +x at 0.5 m/s under a sheet pinned at one edge, one file per frame.
-write_body() { # write_body FOLDER FIRST LAST NAME_PRINTF_FORMAT
+# (A fifth argument: the metres it slides a frame instead.)
+write_body() { # write_body FOLDER FIRST LAST NAME_PRINTF_FORMAT [STEP]
     mkdir -p "$1"
     for ((f = $2; f <= $3; f++)); do
-        awk -v x=$(awk -v k=$((f - $2)) 'BEGIN { printf "%.6f", k * 0.5 / 24 }') 'BEGIN {
+        awk -v x=$(awk -v k=$((f - $2)) -v s="${5:-}" 'BEGIN { printf "%.6f", s == "" ? k * 0.5 / 24 : k * s }') 'BEGIN {
             split("-0.2 0.2", X); split("0.2 0.5", Y); split("-0.2 0.2", Z)
             for (i = 1; i <= 2; i++) for (j = 1; j <= 2; j++) for (k = 1; k <= 2; k++)
                 printf "v %.6f %.6f %.6f\n", X[i] + x, Y[j], Z[k]
@@ -100,7 +101,7 @@ done
 # A name that matches no file says which tokens gale reads.
 write_scene renumbered/bad.toml 0 11 0 'cache/body.%03d.obj'
 run "$GALE" check renumbered/bad.toml
-expect_rc 1 "a sequence with no files"
+expect_rc 3 "a sequence with no files (a missing file: exit 3)"
 expect_match "$ERR" "bad.toml:[0-9]+:[0-9]+: .*no files of the sequence.*%04d or \\\$F4" "the error names the tokens ($ERR)"
 
 # Frame files that are symbolic links to a cache elsewhere are the scene's own choice.
@@ -126,6 +127,13 @@ for f in renumbered/cache/*.obj; do awk '/^v / { printf "v %.4f %.4f %.4f\n", $2
 write_scene cm/scene.toml 0 11 0 'cache/body.####.obj'
 run "$GALE" check cm/scene.toml
 expect_match "$ERR" "scene.toml:16:1: warning: .*'box' is [0-9.]+ m across, [0-9.]+x the largest cloth .*centimetres" "a body in centimetres ($ERR)"
+# A body of the cloth's size that travels far (30 m over the run) is not taken for centimetres:
+# its size is that of one frame, not of the ground it covers.
+write_body travels/cache 0 12 'body.%04d.obj' 2.5
+write_scene travels/scene.toml 0 11 0 'cache/body.####.obj'
+run "$GALE" check travels/scene.toml
+expect_rc 0 "a body that travels far checks"
+expect_no_match "$ERR" "centimetres" "a body that travels far is not in centimetres ($ERR)"
 mkdir -p far/cache
 for f in renumbered/cache/*.obj; do awk '/^v / { printf "v %.4f %.4f %.4f\n", $2 + 30, $3, $4; next } { print }' "$f" > far/cache/$(basename "$f"); done
 write_scene far/scene.toml 0 11 0 'cache/body.####.obj'

@@ -42,6 +42,14 @@ run "$GALE" viz scene.toml --sim out --frames 2 --plane y=1 --style none --no-fi
 expect_rc 0 "a picture with the wind speed given again"
 expect_no_match "$ERR" "with the run's overrides" "no claim that the run's speed is drawn ($ERR)"
 expect_match "$ERR" "the run's --set windicator.speed=6 replaced by this command's --set" "the replaced override is said"
+# The same entry spelled by name in one command and by index in the other is the same key.
+run "$GALE" sim scene.toml -o named --frames 1:2 --set cloth.sheet.drag=0.5
+expect_rc 0 "a run with an override by name"
+run "$GALE" viz scene.toml --sim named --frames 2 --plane y=1 --style none --no-field -o 'r.#.svg' --size 320x320 \
+    --set cloth.0.drag=2
+expect_rc 0 "a picture with the override by index"
+expect_no_match "$ERR" "with the run's overrides" "no claim that the run's drag is drawn ($ERR)"
+expect_match "$ERR" "the run's --set cloth.sheet.drag=0.5 replaced by this command's --set" "the replaced override is said, by index ($ERR)"
 # The body's fills are grey: red = green, blue a little below (cloth is blue, text and frame
 # are blue-grey). Their leftmost x in the picture follows the body, which moved 0.3 m along +x.
 body_left() {
