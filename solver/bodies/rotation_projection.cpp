@@ -15,16 +15,17 @@ namespace gale::solver {
 
 namespace {
 constexpr int kMaxIterations = 6; // Gauss–Newton iterations
-// ... and up to kMaxLateIterations while an edge is still beyond its target by kLateExcess, or by
-// kLateTolerances times the tolerance where that is more. An edge joins the active set only once
-// a neighbour's move has lengthened it, so a chain turning about a contact (a flap over a box's
-// edge, 6 edges long) needs about an iteration per edge: at 6 its outer edge was left 1.45× rest.
-// (Below kLateExcess, the vertices the later iterations move along a curved collider's tangent
-// plane end inside it, for the push-out after the solve; in free air, at a tolerance of 3 %, the
-// later iterations for every edge beyond 3 % cost the wind-onset flag 25–35 % of its median
-// frame; for those beyond 15 % the cost is within the noise, and its stretch still 1.40 → 1.19.)
-constexpr int kMaxLateIterations = 24;
-constexpr double kLateExcess = 0.02;
+// ... and up to LateIterations::iterations more while an edge is still beyond its target by
+// LateIterations::excess, or by kLateTolerances times the tolerance where that is more. An edge
+// joins the active set only once a neighbour's move has lengthened it, so a chain turning about
+// a contact (a flap over a box's edge, 6 edges long) needs about an iteration per edge: at 6 its
+// outer edge was left 1.45× rest. (The defaults, 2 % and 18 (24 in all), are a strand's: below
+// 2 % the vertices the later iterations move along a curved collider's tangent plane end inside
+// it, for the push-out after the solve, which stretches the strand (hair dropped on a sphere at
+// μ = 0.5: 1.029 → 1.082 at 0.5 %); a cloth's are Body's kClothLate. In free air, at a
+// tolerance of 3 %, the later iterations for every edge beyond 3 % cost the wind-onset flag
+// 25–35 % of its median frame; for those beyond 15 % the cost is within the noise, and its
+// stretch still 1.40 → 1.19.)
 constexpr double kLateTolerances = 5.0;
 constexpr int kMaxLimitIterations = 30;  // ... with a stretch limit (a bound, not a correction)
 constexpr int kMaxCg = 60;               // CG iterations per Gauss–Newton iteration
@@ -38,7 +39,8 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
                       const VecX& mass, const Constraints& constraints, const VecX& x0,
                       const VecX& v0, const VecX& y, double h, VecX& dv, double tolerance,
                       const std::function<Vec3(int)>& hold, bool rotations, double stretchLimit,
-                      const std::vector<double>* caps, const std::vector<double>* floors) {
+                      const std::vector<double>* caps, const std::vector<double>* floors,
+                      const LateIterations& late) {
     RotationProjectionStats stats;
     const size_t n = static_cast<size_t>(mass.size());
     VecX x = x0 + h * (v0 + dv) + y;
@@ -117,7 +119,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
     std::vector<Vec3> dir, u;
     std::vector<double> c, lambda, r, z, p, q, diag;
     const bool bound = stretchLimit > 0.0 || caps; // a bound, not a correction
-    const int maxIterations = bound ? kMaxLimitIterations : kMaxLateIterations;
+    const int maxIterations = bound ? kMaxLimitIterations : kMaxIterations + late.iterations;
     for (int it = 0; it < maxIterations; ++it) {
         active.clear();
         dir.clear();
@@ -148,7 +150,7 @@ projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::v
         }
         if (active.empty()) break;
         if (it >= kMaxIterations && !bound &&
-            !(most > std::max(kLateExcess, kLateTolerances * tolerance)))
+            !(most > std::max(late.excess, kLateTolerances * tolerance)))
             break;
         u.resize(verts.size());
         ++stats.iterations;

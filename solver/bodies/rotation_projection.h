@@ -33,12 +33,18 @@ struct RotationProjectionStats {
 // be null): every target capped at caps[e] as well (the lengths an edge had before a move that
 // stretched it: Body's projection after the continuous sweep); floors (m, per edge; may be null):
 // an edge shorter than floors[e] by more than the tolerance is lengthened to it as well.
+// late: after the first Gauss–Newton iterations, up to `iterations` more are made while an edge
+// is still beyond its target by `excess` × rest (or by 5× the tolerance where that is more).
+struct LateIterations {
+    double excess = 0.02;
+    int iterations = 18;
+};
 RotationProjectionStats
 projectRotationLength(const std::vector<std::array<int, 2>>& edges, const std::vector<double>& rest,
                       const VecX& mass, const Constraints& constraints, const VecX& x0,
                       const VecX& v0, const VecX& y, double h, VecX& dv, double tolerance,
                       const std::function<Vec3(int)>& hold = {}, bool rotations = true,
                       double stretchLimit = 0.0, const std::vector<double>* caps = nullptr,
-                      const std::vector<double>* floors = nullptr);
+                      const std::vector<double>* floors = nullptr, const LateIterations& late = {});
 
 } // namespace gale::solver
