@@ -25,12 +25,12 @@ constexpr int kGmresRestart = 20;
 constexpr int kGmresRestarts = 4;
 // Solves of a substep after the first for changes of the contact set (updateContacts).
 constexpr int kContactRounds = 8;
-// A cloth's rotation projection goes on past its first iterations while an edge is 0.5 % beyond
-// its target, for up to 58 more (a strand's: the defaults, rotation_projection.h). At 2 % and
-// 18, sheets dropped on capsules of 3–8 cm ended 1.015–1.019× rest where 16 substeps a frame give
-// 1.002–1.003×, the outer edges of their flaps left long by the projection; a sheet toppling
-// edge-first onto the floor 1.015–1.020× (16 substeps: 1.002×). Now 1.005–1.010× both
-// (bench/README.md, "The rotation projection's late iterations on cloth").
+// A cloth's rotation projection (without self-collision: Body::projectRotations) goes on past its
+// first iterations while an edge is 0.5 % beyond its target (a strand's: the defaults, 2 %,
+// rotation_projection.h). At 2 %, sheets dropped on capsules of 3–8 cm ended 1.015–1.019× rest
+// where 16 substeps a frame give 1.002–1.003×, the outer edges of their flaps left long by the
+// projection, and one landing on a 20° slab 1.044× (16: 1.006×); at 0.5 %, 1.005–1.008× and
+// 1.005× (bench/README.md, "The rotation projection's late iterations on cloth").
 constexpr LateIterations kClothLate{0.005, 18};
 // The PCG residual's absolute floor, as a fraction of the CG tolerance of gravity's impulse over
 // the step (substep(), FilteredSolver::setResidualFloor).
@@ -818,22 +818,28 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
         return normal;
     };
     const VecX dvBefore = mDv;
+    // A cloth without self-collision: its projection goes on to kClothLate's 0.5 %, and its
+    // vertices held or released by a collider are backed out to the thickness (below). With
+    // self-collision the pass after the solve meets what those moves do to the cloth's folds: the
+    // storm cape of tests/cli/cape_storm_body.sh had a frame of 4.25× the median's substeps
+    // (2.75× without), and with the portable kernels one of 47× (a pass accepted at 1.41× rest,
+    // every substep after it halved to the smallest). A strand keeps the defaults.
+    const bool lonelyCloth = collisionTriangles() != nullptr && !collision().self;
     const RotationProjectionStats ps =
         projectRotationLength(mEdges, mEdgeRest, mMass, constraints ? *constraints : mConstraints,
                               x0, v0, mYPos, h, mDv, tolerance, hold, rotations, stretchLimit, caps,
-                              floors, collisionTriangles() ? kClothLate : LateIterations{});
+                              floors, lonelyCloth ? kClothLate : LateIterations{});
     // Every vertex it moved that a collider's surface came closer to (a curved one under a
     // contact sliding in its plane, or under a vertex moving in the tangent plane of its
     // nearest point): back out along the normal to the distance it had, or to the thickness. A
-    // cloth vertex held by a collider in the solve, or released by the rounds, goes back to the
+    // lonely cloth's vertex held by a collider in the solve, or released by the rounds, goes to the
     // thickness even where the step had left it nearer: sliding in the tangent plane of a curved
     // surface it ends inside its thickness by s²/2R, and a released one drifts back into it
     // (0.06–0.08 mm on a 15 cm ball), for the push-out after the solve otherwise. Not against a
-    // moving mesh, whose sweep after the solve has the last word there. (Any cloth vertex the
-    // projection moved, so backed out, pumped the storm cape of tests/cli/cape_storm_body.sh into
-    // its own folds: 1.25 → 1.27, 8.75× the median frame's substeps in one frame. A strand's held
-    // vertex, hair swept by a ball at 1 m/s: 5 → 26 %.)
-    const bool cloth = collisionTriangles() != nullptr;
+    // moving mesh, whose sweep after the solve has the last word there. (Every cloth vertex the
+    // projection moved, so backed out, took the storm cape of tests/cli/cape_storm_body.sh to a
+    // frame of 8.75× the median's substeps; a strand's held vertex, hair swept by a ball at
+    // 1 m/s, from 5 to 26 % stretch.)
     for (size_t v = 0; v < vertexCount() && !mKin.colliders.empty(); ++v) {
         if (vec3At(mDv.data(), v) == vec3At(dvBefore.data(), v)) continue;
         const Vec3 x1 = endOf(dvBefore, v);
@@ -844,7 +850,7 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
             const Vec3 x = endOf(mDv, v);
             if (!endPoseQuery(k, v, x, reach, after) || !(after.distance < thick)) continue;
             const double was = endPoseQuery(k, v, x1, reach, before) ? before.distance : reach;
-            const bool held = cloth && was >= 0.0 && !mKin.colliders[k].end.moving &&
+            const bool held = lonelyCloth && was >= 0.0 && !mKin.colliders[k].end.moving &&
                               (mContactCollider[v] == static_cast<int>(k) ||
                                (v < mReleased.size() && mReleased[v]));
             const double floor = held ? thick : std::min(was, thick);
