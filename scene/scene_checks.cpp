@@ -129,6 +129,14 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         for (const auto& [v, p] : bound) bodyBoxes.back().add(p);
         cloth.add(bodyBoxes.back());
     }
+    // The longest edge at rest of any cloth (m): what a thin static mesh is measured against.
+    double longestClothEdge = 0.0;
+    for (size_t i = 0; i < scene.cloths.size() && i < bodies.size(); ++i) {
+        const solver::VecX& rest = bodies[i]->restPositions();
+        for (const auto& [a, b] : bodies[i]->edges())
+            longestClothEdge = std::max(longestClothEdge,
+                                        (rest.segment<3>(3 * a) - rest.segment<3>(3 * b)).norm());
+    }
     // A selection that holds nothing (a box beside the cloth, a map that is zero everywhere).
     const auto heldBy = [](const solver::Body& body, bool attachments) {
         size_t n = 0;
@@ -429,6 +437,28 @@ std::vector<SceneError> runWarnings(const SimScene& scene,
         const Box box = colliderBox(c, s.frameTime(first), &size);
         if (box.empty() || cloth.empty() || !(clothExtent > 0.0)) continue;
         checkScale(size, c.line, c.col, what);
+        // A static mesh thinner than the cloth's edges (or than two of its SDF's voxels): its
+        // contact is per cloth vertex, so a plate or rod standing between two rows of vertices
+        // goes through the cloth's faces (a 1 cm plate on edge under a sheet of 2.2 cm spacing:
+        // the sheet fell through it untouched).
+        if (c.mesh && longestClothEdge > 0.0) {
+            const Vec3 span = box.hi - box.lo;
+            int axis = 0;
+            span.minCoeff(&axis);
+            const double voxel = c.mesh->sdf().voxel();
+            const std::string thin = what + " is a static mesh " + metres(span[axis]) +
+                                     " m thin along " + "xyz"[axis] + ", less than ";
+            if (span[axis] < longestClothEdge)
+                warn(c, thin + "the longest cloth edge (" + metres(longestClothEdge) +
+                            " m): its contact is per cloth vertex (its SDF), so cloth can pass "
+                            "through it between vertices; give it as a one-frame sequence (name "
+                            "the file with a frame token, body.#.obj: continuous contact against "
+                            "its triangles and edges), or as a capsule where it is a rod");
+            else if (span[axis] < 2.0 * voxel)
+                warn(c, thin + "two of its SDF's voxels (" + metres(voxel) +
+                            " m), which cannot hold its shape: set voxel to at most " +
+                            metres(span[axis] / 4.0) + " m");
+        }
         double nearest = std::numeric_limits<double>::infinity();
         for (const Box& b : bodyBoxes) nearest = std::min(nearest, box.gap(b));
         // Reach: twice the cloth's size, and as far as a body falls over the run (½ g T²: a
