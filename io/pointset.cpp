@@ -51,13 +51,23 @@ int PointSet::addColumn(const std::string& name) {
     return c;
 }
 
-std::string IoError::render() const {
-    std::string s = file.empty() ? std::string("<input>") : file;
-    if (line > 0) {
-        s += ':' + std::to_string(line);
-        if (col > 0) s += ':' + std::to_string(col);
+namespace {
+std::string locationOf(const IoError& e) {
+    std::string s = e.file.empty() ? std::string("<input>") : e.file;
+    if (e.line > 0) {
+        s += ':' + std::to_string(e.line);
+        if (e.col > 0) s += ':' + std::to_string(e.col);
     }
-    return s + ": error: " + message;
+    return s;
+}
+} // namespace
+
+std::string IoError::render() const {
+    return locationOf(*this) + ": error: " + message;
+}
+
+std::string IoError::brief() const {
+    return locationOf(*this) + ": " + message;
 }
 
 namespace detail {

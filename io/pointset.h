@@ -40,6 +40,8 @@ struct IoError {
     explicit operator bool() const { return kind != None; }
     // "file:line:col: error: message" (line/col left out when unknown).
     std::string render() const;
+    // "file:line:col: message": for a caller's own diagnostic, which says "error:" itself.
+    std::string brief() const;
 };
 
 enum class PointFormat { Csv, Ply, PlyAscii, Obj, Json, Npy };

@@ -34,12 +34,12 @@ Strands makeStrandGrid(const Vec3& origin, double width, double depth, int nu, i
 bool loadStrands(const std::string& path, Strands& out, std::string& error) {
     io::PointSet ps;
     if (io::IoError e = io::readPoints(path, ps)) {
-        error = e.render();
+        error = e.brief(); // the caller's diagnostic says "error:" once
         return false;
     }
     const int ix = ps.find("x"), iy = ps.find("y"), iz = ps.find("z"), is = ps.find("strand");
     if (ix < 0 || iy < 0 || iz < 0 || is < 0) {
-        error = path + ": error: strands need x, y, z and an integer 'strand' vertex property";
+        error = path + ": strands need x, y, z and an integer 'strand' vertex property";
         return false;
     }
     out = Strands{};
@@ -59,7 +59,7 @@ bool loadStrands(const std::string& path, Strands& out, std::string& error) {
         i = j;
     }
     if (out.strandCount() == 0) {
-        error = path + ": error: no strand has two or more vertices";
+        error = path + ": no strand has two or more vertices";
         return false;
     }
     for (size_t c = 0; c < ps.names.size(); ++c) {

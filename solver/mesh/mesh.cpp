@@ -44,13 +44,7 @@ bool loadMesh(const std::string& path, TriMesh& out, std::string& error, int* dr
     io::PointSet ps;
     io::IoError e = io::readPoints(path, ps);
     if (e) {
-        // "file:line:col: message": the caller's diagnostic says "error:" once.
-        std::string where = e.file.empty() ? path : e.file;
-        if (e.line > 0) {
-            where += ':' + std::to_string(e.line);
-            if (e.col > 0) where += ':' + std::to_string(e.col);
-        }
-        error = where + ": " + e.message;
+        error = e.brief(); // the caller's diagnostic says "error:" once
         return false;
     }
     const int ix = ps.find("x"), iy = ps.find("y"), iz = ps.find("z");
