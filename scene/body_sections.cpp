@@ -31,14 +31,9 @@ namespace {
 // Where a key's value was written, for the errors the build gives later (a mesh that cannot be
 // read): its line and column in the scene file, or (line 0) the --set that gave it.
 void keyPlace(const toml::node& n, int& line, int& col, std::string& origin) {
-    const auto& path = n.source().path;
-    if (path && path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
-        origin = *path;
-        line = col = 0;
-        return;
-    }
-    line = static_cast<int>(n.source().begin.line);
-    col = static_cast<int>(n.source().begin.column);
+    origin = setOrigin(n.source());
+    line = origin.empty() ? static_cast<int>(n.source().begin.line) : 0;
+    col = origin.empty() ? static_cast<int>(n.source().begin.column) : 0;
 }
 
 // Generated cloth and hair grids: at most this many vertices (a million already takes the
@@ -352,11 +347,8 @@ bool Loader::attach(const toml::node& n, const std::string& what, const std::str
     }
     bool ok = true;
     const toml::node* m = t->get("mesh");
-    for (const toml::node* from : {m, &n}) { // the mesh's --set, else the table's
-        if (!from || !out.origin.empty()) continue;
-        const auto& path = from->source().path;
-        if (path && path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) out.origin = *path;
-    }
+    for (const toml::node* from : {m, &n}) // the mesh's --set, else the table's
+        if (from && out.origin.empty()) out.origin = setOrigin(from->source());
     std::string file;
     if (!m) {
         error(n, what + " needs mesh = \"file\" (the body to attach to: OBJ/PLY, or a '#' sequence)");

@@ -7,12 +7,16 @@
 #include "scene/toml_reader.h"
 #include "scene/toml_util.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
 namespace gale::scene {
 
 namespace fs = std::filesystem;
+
+// The scene's [[list]] sections, whose entries --set names by name or index.
+const std::vector<std::string> kListSections = {"gust", "field", "cloth", "hair", "collider"};
 
 struct SceneDocument::Impl {
     std::string path, text;
@@ -49,7 +53,7 @@ bool SceneDocument::applySets(const std::vector<std::string>& sets,
     TomlReader reader(m->path, m->text, errors);
     SetSections sections;
     sections.tables = {"scene", "windicator", "solver"};
-    sections.lists = {"gust", "field", "cloth", "hair", "collider"};
+    sections.lists = kListSections;
     sections.pathsNote = "scene paths look like windicator.speed, scene.fps, gust.NAME.strength, "
                          "field.NAME.params.PARAM, cloth.NAME.drag or solver.max_halvings";
     reader.applySets(m->root, sets, sections);
@@ -61,19 +65,14 @@ std::string SceneDocument::canonicalSetKey(const std::string& set) const {
     std::vector<std::string> parts = splitText(key, '.');
     if (parts.size() < 3) return key;
     const std::string& head = parts[0];
-    if (head != "gust" && head != "field" && head != "cloth" && head != "hair" &&
-        head != "collider")
+    if (std::find(kListSections.begin(), kListSections.end(), head) == kListSections.end())
         return key;
     const toml::array* list = m->root.get(head) ? m->root.get(head)->as_array() : nullptr;
     if (!list) return key;
     for (size_t i = 0; i < list->size(); ++i) {
         const toml::table* t = list->get(i)->as_table();
         if (!t) continue;
-        // (As applySets names entries: a gust has no default name, only its index.)
-        const std::string name = t->get("name") && t->get("name")->is_string()
-                                     ? t->get("name")->value<std::string>().value_or("")
-                                 : head == "gust" ? std::string()
-                                                  : head + std::to_string(i);
+        const std::string name = listEntryName(*t, head, i);
         if ((!name.empty() && name == parts[1]) || parts[1] == std::to_string(i)) {
             parts[1] = std::to_string(i);
             std::string out = parts[0];

@@ -24,15 +24,21 @@
 
 namespace gale::scene {
 
+namespace {
+// An error at a key: the --set that gave it (`origin`), else its line and column in `file`.
+SceneError keyError(const std::string& file, const std::string& origin, int line, int col,
+                    std::string message) {
+    if (origin.empty()) return sceneErrorAt(file, line, col, std::move(message));
+    SceneError e;
+    e.file = origin;
+    e.message = std::move(message);
+    return e;
+}
+} // namespace
+
 SceneError specError(const std::string& file, const PinSpec& spec, std::string message,
                      bool warning) {
-    SceneError e;
-    if (!spec.origin.empty()) {
-        e.file = spec.origin;
-        e.message = std::move(message);
-    } else {
-        e = sceneErrorAt(file, spec.line, spec.col, std::move(message));
-    }
+    SceneError e = keyError(file, spec.origin, spec.line, spec.col, std::move(message));
     e.warning = warning;
     return e;
 }
@@ -43,20 +49,6 @@ namespace {
 
 SceneError sceneError(const SimScene& scene, int line, int col, std::string message) {
     return sceneErrorAt(scene.wind.path, line, col, std::move(message));
-}
-
-// An error at a key: the --set that gave it (`origin`), else its line and column, else (line 0)
-// its section's header at `line0`, `col0`.
-SceneError keyError(const SimScene& scene, const std::string& origin, int line, int col, int line0,
-                    int col0, std::string message) {
-    if (!origin.empty()) {
-        SceneError e;
-        e.file = origin;
-        e.message = std::move(message);
-        return e;
-    }
-    return line > 0 ? sceneError(scene, line, col, std::move(message))
-                    : sceneError(scene, line0, col0, std::move(message));
 }
 
 Vec3 axisOf(char c) {
@@ -367,8 +359,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
             std::string error;
             int dropped = 0;
             if (!loadMesh(spec.meshPath, mesh, error, &dropped)) {
-                SceneError e = keyError(scene, spec.meshOrigin, spec.meshLine, spec.meshCol,
-                                        spec.line, spec.col, what + ": " + error);
+                SceneError e = keyError(scene.wind.path, spec.meshOrigin, spec.meshLine,
+                                        spec.meshCol, what + ": " + error);
                 e.io = isFileProblem(error);
                 errors.push_back(std::move(e));
                 continue;
@@ -489,9 +481,8 @@ bool buildBodies(const SimScene& scene, std::vector<std::unique_ptr<Body>>& bodi
         } else {
             std::string error;
             if (!loadStrands(spec.strandsPath, strands, error)) {
-                errors.push_back(keyError(scene, spec.strandsOrigin, spec.strandsLine,
-                                          spec.strandsCol, spec.line, spec.col,
-                                          what + ": " + error));
+                errors.push_back(keyError(scene.wind.path, spec.strandsOrigin, spec.strandsLine,
+                                          spec.strandsCol, what + ": " + error));
                 errors.back().io = isFileProblem(error);
                 continue;
             }

@@ -53,7 +53,7 @@ SceneError specError(const std::string& file, const PinSpec& spec, std::string m
 struct ClothSpec {
     std::string name;
     std::string meshPath; // resolved; empty for a generated grid
-    int meshLine = 0, meshCol = 0; // where mesh was written (0: the header's)
+    int meshLine = 0, meshCol = 0; // where mesh was written (0: by --set, meshOrigin)
     std::string meshOrigin;        // "--set cloth.NAME.mesh=..." when it was given there
     double gridSize[2] = {1.0, 1.0};
     int gridRes[2] = {16, 16};
@@ -84,7 +84,7 @@ struct ClothSpec {
 struct HairSpec {
     std::string name;
     std::string strandsPath; // resolved; empty for generated strands
-    int strandsLine = 0, strandsCol = 0; // where strands was written (0: the header's)
+    int strandsLine = 0, strandsCol = 0; // where strands was written (0: by --set)
     std::string strandsOrigin;           // "--set hair.NAME.strands=..." when given there
     double gridSize[2] = {0.1, 0.1};
     int gridCount[2] = {4, 4};

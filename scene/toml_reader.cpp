@@ -32,11 +32,22 @@ TomlReader::TomlReader(std::string path, const std::string& text, std::vector<Sc
     }
 }
 
+std::string setOrigin(const toml::source_region& where) {
+    return where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0 ? *where.path
+                                                                                    : std::string();
+}
+
+std::string listEntryName(const toml::table& entry, const std::string& head, size_t index) {
+    if (const toml::node* n = entry.get("name"); n && n->is_string())
+        return n->value<std::string>().value_or("");
+    return head == "gust" ? std::string() : head + std::to_string(index);
+}
+
 SceneError& TomlReader::error(const toml::source_region& where, std::string message) {
     SceneError e;
     e.message = std::move(message);
-    if (where.path && where.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) {
-        e.file = *where.path;
+    if (std::string origin = setOrigin(where); !origin.empty()) {
+        e.file = std::move(origin);
     } else {
         e.file = mPath;
         e.line = static_cast<int>(where.begin.line);
@@ -139,16 +150,12 @@ void TomlReader::applySets(toml::table& root, const std::vector<std::string>& se
                 setError(set, "expected " + head + ".NAME.KEY (or " + head + ".INDEX.KEY, from 0)");
                 continue;
             }
-            // Entries without a name are called <head><index> (field0, cloth1, ...), except
-            // gusts, which have no default name (only their index).
             std::vector<std::string> names;
             if (list) {
                 for (size_t i = 0; i < list->size(); ++i) {
                     toml::table* t = list->get(i)->as_table();
                     if (!t) continue;
-                    std::string name = t->get("name") && t->get("name")->is_string()
-                                           ? t->get("name")->value<std::string>().value_or("")
-                                           : (head == "gust" ? std::string() : head + std::to_string(i));
+                    const std::string name = listEntryName(*t, head, i);
                     if (!name.empty()) names.push_back(name);
                     if (!target && (name == parts[1] || parts[1] == std::to_string(i))) target = t;
                 }

@@ -26,6 +26,13 @@ inline std::string widthText(int width) {
 
 inline constexpr std::string_view kSetPrefix = "--set ";
 
+// The `--set KEY=VALUE` a value came from (its source path, "--set ..."); "" for the scene file.
+std::string setOrigin(const toml::source_region& where);
+
+// What `--set` calls entry `index` of a [[head]] list: its name, else <head><index> (field0,
+// cloth1, ...), except a gust, which has no default name ("": only its index).
+std::string listEntryName(const toml::table& entry, const std::string& head, size_t index);
+
 // The scene paths one section loader takes from `--set`.
 struct SetSections {
     std::vector<std::string> tables; // [name] sections: name.KEY...

@@ -98,7 +98,7 @@ void Loader::verbatimPosition(const toml::node& n, const std::string& value, int
                               int& col) const {
     line = col = 0;
     const toml::source_region& r = n.source();
-    if (r.path && r.path->compare(0, kSetPrefix.size(), kSetPrefix) == 0) return;
+    if (!setOrigin(r).empty()) return; // given by --set: not in the scene's text
     size_t at = offsetOf(r.begin);
     if (at == std::string::npos || at >= mText.size()) return;
     const char q = mText[at];

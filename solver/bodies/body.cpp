@@ -850,10 +850,10 @@ void Body::projectRotations(const VecX& x0, const VecX& v0, double h, SubstepSta
             const Vec3 x = endOf(mDv, v);
             if (!endPoseQuery(k, v, x, reach, after) || !(after.distance < thick)) continue;
             const double was = endPoseQuery(k, v, x1, reach, before) ? before.distance : reach;
-            const bool held = lonelyCloth && was >= 0.0 && !mKin.colliders[k].end.moving &&
-                              (mContactCollider[v] == static_cast<int>(k) ||
-                               (v < mReleased.size() && mReleased[v]));
-            const double floor = held ? thick : std::min(was, thick);
+            const bool toThickness = lonelyCloth && was >= 0.0 && !mKin.colliders[k].end.moving &&
+                                     (mContactCollider[v] == static_cast<int>(k) ||
+                                      (v < mReleased.size() && mReleased[v]));
+            const double floor = toThickness ? thick : std::min(was, thick);
             if (after.distance < floor)
                 vec3At(mDv.data(), v) += ((floor - after.distance) / h) * after.normal;
         }

@@ -176,11 +176,12 @@ TEST_CASE("rotation projection: the late iterations go on down to the caller's e
         VecX dv = turned;
         const RotationProjectionStats s = projectRotationLength(
             edges, rest, mass, c, x0, v0, y, h, dv, 1e-3, {}, true, 0.0, nullptr, nullptr, late);
+        const VecX x = x0 + h * dv;
         double worst = 0.0;
         for (size_t e = 0; e < edges.size(); ++e) {
             const auto [a, b] = edges[e];
-            const Vec3 d = (x0 + h * dv).segment<3>(3 * b) - (x0 + h * dv).segment<3>(3 * a);
-            worst = std::max(worst, d.norm() / rest[e] - 1.0);
+            worst =
+                std::max(worst, (x.segment<3>(3 * b) - x.segment<3>(3 * a)).norm() / rest[e] - 1.0);
         }
         CHECK(s.excessAfter == Approx(worst).margin(1e-9));
         return worst;
